@@ -1,0 +1,66 @@
+#include "deploy/cellctl/product_report.hpp"
+
+#include <cmath>
+
+#include "deploy/cellctl/text_table.hpp"
+
+namespace cellctl {
+
+twin::Vec3 xyz_degrees(const twin::Quat& q) {
+  const twin::Vec3 zyx = q.toRotationMatrix().eulerAngles(2, 1, 0);
+  return twin::Vec3(zyx[2], zyx[1], zyx[0]) * (180.0 / M_PI);
+}
+
+nlohmann::json product_json(const twin::Product& product) {
+  nlohmann::json parts = nlohmann::json::array();
+  for (const auto& part : product.parts()) {
+    const twin::Vec3 p = part.final_pose.translation();
+    const twin::Quat q(part.final_pose.linear());
+    nlohmann::json j = {{"id", part.id},
+                        {"name", part.name},
+                        {"type", twin::short_type_name(part.type)},
+                        {"position", {p.x(), p.y(), p.z()}},
+                        {"orientation", {q.w(), q.x(), q.y(), q.z()}}};
+    if (part.color) j["color"] = *part.color;
+    if (part.mesh) j["mesh"] = part.mesh->file.filename().string();
+    parts.push_back(std::move(j));
+  }
+  nlohmann::json connections = nlohmann::json::array();
+  for (const auto& c : product.connections()) {
+    connections.push_back({{"part1", product.parts()[c.part1].name},
+                           {"interface1", c.interface1},
+                           {"part2", product.parts()[c.part2].name},
+                           {"interface2", c.interface2},
+                           {"name", c.name}});
+  }
+  return {{"schema", "agile-cell/product"},
+          {"version", 1},
+          {"product", product.name()},
+          {"source", product.source().string()},
+          {"units", {{"length", "m"}}},
+          {"parts", parts},
+          {"connections", connections}};
+}
+
+void print_product_table(const twin::Product& product, std::ostream& out) {
+  out << "Product '" << product.name() << "' from " << product.source().string() << ": "
+      << product.parts().size() << " parts, " << product.connections().size() << " links\n\n";
+  TextTable parts({"#", "part", "type", "color", "x mm", "y mm", "z mm", "rx deg", "ry deg", "rz deg", "mesh"});
+  for (std::size_t i = 0; i < product.parts().size(); ++i) {
+    const auto& part = product.parts()[i];
+    const twin::Vec3 p = part.final_pose.translation() * 1000.0;
+    const twin::Vec3 r = xyz_degrees(twin::Quat(part.final_pose.linear()));
+    parts.add_row({std::to_string(i + 1), part.name, twin::short_type_name(part.type), part.color.value_or("-"),
+                   fixed(p.x(), 2), fixed(p.y(), 2), fixed(p.z(), 2), fixed(r.x(), 1), fixed(r.y(), 1),
+                   fixed(r.z(), 1), part.mesh ? part.mesh->file.filename().string() : "-"});
+  }
+  parts.print(out);
+  out << '\n';
+  TextTable links({"link", "part", "interface", "part", "interface"});
+  for (const auto& c : product.connections()) {
+    links.add_row({c.name, product.parts()[c.part1].name, c.interface1, product.parts()[c.part2].name, c.interface2});
+  }
+  links.print(out);
+}
+
+}  // namespace cellctl

@@ -1,0 +1,19 @@
+#pragma once
+// The finished product as people and programs read it: a table and a JSON document.
+
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "twin/model/product.hpp"
+
+namespace cellctl {
+
+// Schema "agile-cell/product" version 1, documented in docs/cli.md.
+nlohmann::json product_json(const twin::Product& product);
+void print_product_table(const twin::Product& product, std::ostream& out);
+
+// Extrinsic X, Y, Z angles in degrees (the orientation attribute's own convention).
+twin::Vec3 xyz_degrees(const twin::Quat& q);
+
+}  // namespace cellctl

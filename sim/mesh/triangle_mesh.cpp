@@ -1,0 +1,59 @@
+#include "sim/mesh/triangle_mesh.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+namespace sim {
+namespace {
+
+void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent, TriangleMesh& out) {
+  const aiMatrix4x4 transform = parent * node.mTransformation;
+  for (unsigned m = 0; m < node.mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene.mMeshes[node.mMeshes[m]];
+    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
+    std::vector<std::uint32_t> piece;
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      const aiVector3D p = transform * mesh.mVertices[v];
+      out.vertices.emplace_back(p.x, p.y, p.z);
+      out.bounds.extend(out.vertices.back());
+      piece.push_back(base + v);
+    }
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      out.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+    }
+    out.pieces.push_back(std::move(piece));
+  }
+  for (unsigned c = 0; c < node.mNumChildren; ++c) append_node(scene, *node.mChildren[c], transform, out);
+}
+
+}  // namespace
+
+std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(
+      file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+    throw MeshError("cannot read mesh " + file.string() + ": " + importer.GetErrorString());
+  }
+  auto mesh = std::make_shared<TriangleMesh>();
+  append_node(*scene, *scene->mRootNode, aiMatrix4x4(), *mesh);
+  if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds no triangles");
+  for (const auto& v : mesh->vertices) {
+    if (!v.allFinite()) throw MeshError("mesh " + file.string() + " has a vertex that is not finite");
+  }
+  return mesh;
+}
+
+std::shared_ptr<const TriangleMesh> MeshCache::get(const std::filesystem::path& file) {
+  const std::string key = file.string();
+  if (auto it = meshes_.find(key); it != meshes_.end()) return it->second;
+  auto mesh = load_mesh(file);
+  meshes_.emplace(key, mesh);
+  return mesh;
+}
+
+}  // namespace sim

@@ -1,0 +1,45 @@
+#pragma once
+// A part's geometry as read from its mesh file, in the part's own frame, in metres.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace sim {
+
+struct TriangleMesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  // The file's objects (OBJ "o"/"g" groups, COLLADA geometries), each a list of vertex
+  // indices. A mesh authored as a convex decomposition has one convex object per piece.
+  std::vector<std::vector<std::uint32_t>> pieces;
+  Eigen::AlignedBox3d bounds;
+};
+
+class MeshError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Reads OBJ, STL, COLLADA, PLY, glTF and the rest of what Assimp reads. Throws MeshError
+// when the file cannot be read or holds no triangles.
+std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file);
+
+// Each file read once, shared by every part that uses it.
+class MeshCache {
+ public:
+  std::shared_ptr<const TriangleMesh> get(const std::filesystem::path& file);
+  std::size_t size() const { return meshes_.size(); }
+
+ private:
+  std::unordered_map<std::string, std::shared_ptr<const TriangleMesh>> meshes_;
+};
+
+}  // namespace sim

@@ -1,0 +1,391 @@
+#include "twin/description/automationml/automationml_description.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+#include "twin/description/automationml/caex_values.hpp"
+#include "twin/description/automationml/xml_file.hpp"
+
+namespace twin {
+namespace {
+
+using aml::child;
+using aml::for_each_child;
+using aml::local_name;
+
+// "{2DDC2CF5-...}" and "2ddc2cf5-..." are the same ID.
+std::string normalize_id(std::string_view id) {
+  if (id.size() >= 2 && id.front() == '{' && id.back() == '}') id = id.substr(1, id.size() - 2);
+  std::string out(id);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
+  return out;
+}
+
+// "BaseLib@Lib/Class" (an alias into an external file) -> "Lib/Class".
+std::string strip_alias(std::string_view path) {
+  const auto at = path.find('@');
+  return std::string(at == std::string_view::npos ? path : path.substr(at + 1));
+}
+
+std::string last_segment(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+bool has_mesh_extension(const std::filesystem::path& file) {
+  static const std::set<std::string> extensions = {".obj", ".stl", ".dae", ".ply", ".gltf",
+                                                   ".glb", ".fbx", ".3ds", ".off"};
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return extensions.count(ext) > 0;
+}
+
+std::string percent_decode(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '%' && i + 2 < text.size() && std::isxdigit(static_cast<unsigned char>(text[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(text[i + 2]))) {
+      out += static_cast<char>(std::stoi(text.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// Reads one CAEX file into items. Owned by AutomationMLDescription's constructor.
+class CaexReader {
+ public:
+  CaexReader(const aml::XmlFile& file, AutomationMLDescription& out) : file_(file), out_(out) {}
+
+  void read() {
+    const pugi::xml_node root = file_.document().document_element();
+    if (local_name(root) != "CAEXFile") {
+      throw DescriptionError(file_.where(root), "not a CAEX file: the root element is <" +
+                                                    std::string(root.name()) +
+                                                    ">, expected <CAEXFile>");
+    }
+    out_.schema_version_ = root.attribute("SchemaVersion").value();
+    index_classes(root);
+
+    bool any_hierarchy = false;
+    for_each_child(root, "InstanceHierarchy", [&](const pugi::xml_node& hierarchy) {
+      any_hierarchy = true;
+      if (out_.product_name_.empty()) out_.product_name_ = product_name_of(hierarchy);
+      for_each_child(hierarchy, "InternalElement",
+                     [&](const pugi::xml_node& e) { read_element(e); });
+    });
+    if (!any_hierarchy) {
+      throw DescriptionError(file_.where(root), "the file has no InstanceHierarchy, so no parts");
+    }
+    emit_type_parameters();
+    for (const pugi::xml_node& link : links_) read_link(link);
+  }
+
+ private:
+  // --- classes -----------------------------------------------------------------------
+
+  void index_classes(const pugi::xml_node& root) {
+    for_each_child(root, "SystemUnitClassLib", [&](const pugi::xml_node& lib) {
+      index_nested(lib, lib.attribute("Name").value(), "SystemUnitClass", unit_classes_);
+    });
+    for_each_child(root, "InterfaceClassLib", [&](const pugi::xml_node& lib) {
+      index_nested(lib, lib.attribute("Name").value(), "InterfaceClass", interface_classes_);
+    });
+  }
+
+  static void index_nested(const pugi::xml_node& parent, const std::string& path,
+                           std::string_view element,
+                           std::unordered_map<std::string, pugi::xml_node>& index) {
+    for_each_child(parent, element, [&](const pugi::xml_node& c) {
+      const std::string own = path + "/" + c.attribute("Name").value();
+      index.emplace(own, c);
+      index_nested(c, own, element, index);
+    });
+  }
+
+  // The class and its bases, most derived first. Classes from other files (aliases that
+  // this file does not define) end the chain.
+  std::vector<pugi::xml_node> class_chain(
+      const std::string& path, const std::unordered_map<std::string, pugi::xml_node>& index,
+      const SourceRef& where) const {
+    std::vector<pugi::xml_node> chain;
+    std::string next = strip_alias(path);
+    std::set<std::string> seen;
+    while (!next.empty()) {
+      const auto it = index.find(next);
+      if (it == index.end()) break;
+      if (!seen.insert(next).second) {
+        throw DescriptionError(where, "class '" + next + "' derives from itself (RefBaseClassPath loop)");
+      }
+      chain.push_back(it->second);
+      next = strip_alias(it->second.attribute("RefBaseClassPath").value());
+    }
+    return chain;
+  }
+
+  bool is_geometry_interface(const pugi::xml_node& interface, const std::filesystem::path& uri) const {
+    const std::string ref = interface.attribute("RefBaseClassPath").value();
+    std::vector<std::string> names = {last_segment(strip_alias(ref))};
+    for (const auto& c : class_chain(ref, interface_classes_, file_.where(interface))) {
+      names.push_back(c.attribute("Name").value());
+      names.push_back(last_segment(strip_alias(c.attribute("RefBaseClassPath").value())));
+    }
+    auto named = [&](const char* n) { return std::find(names.begin(), names.end(), n) != names.end(); };
+    if (named("COLLADAInterface")) return true;
+    if (named("PLCopenXMLInterface")) return false;
+    return (named("ExternalDataReference") || named("ExternalDataConnector")) && has_mesh_extension(uri);
+  }
+
+  // --- instances -----------------------------------------------------------------------
+
+  std::string product_name_of(const pugi::xml_node& hierarchy) const {
+    // The paper's layout: one element (the product) holding the parts.
+    pugi::xml_node only;
+    int count = 0;
+    for_each_child(hierarchy, "InternalElement", [&](const pugi::xml_node& e) {
+      only = e;
+      ++count;
+    });
+    if (count == 1 && child(only, "InternalElement")) return only.attribute("Name").value();
+    return hierarchy.attribute("Name").value();
+  }
+
+  void register_id(const pugi::xml_node& node, const std::string& id) {
+    const auto [it, inserted] = ids_.emplace(id, node);
+    if (!inserted) {
+      throw DescriptionError(file_.where(node), "duplicate ID '" + id + "': " +
+                                                    file_.where(it->second).to_string() +
+                                                    " has it already");
+    }
+  }
+
+  void read_element(const pugi::xml_node& element) {
+    const std::string raw_id = element.attribute("ID").value();
+    if (raw_id.empty()) throw DescriptionError(file_.where(element), "InternalElement has no ID");
+    const std::string id = normalize_id(raw_id);
+    register_id(element, id);
+    collect_links(element);
+
+    if (child(element, "InternalElement")) {  // a product or sub-assembly: its children are parts
+      ++out_.group_count_;
+      group_ids_.insert(id);
+      for_each_child(element, "InternalElement", [&](const pugi::xml_node& e) { read_element(e); });
+      return;
+    }
+    read_part(element, id);
+  }
+
+  void collect_links(const pugi::xml_node& element) {
+    for_each_child(element, "InternalLink", [&](const pugi::xml_node& l) { links_.push_back(l); });
+  }
+
+  void read_part(const pugi::xml_node& element, const std::string& id) {
+    CreatePartItem part;
+    part.id = id;
+    part.name = element.attribute("Name").value();
+    part.where = file_.where(element);
+    if (part.name.empty()) part.name = id;
+
+    const std::string type_ref = element.attribute("RefBaseSystemUnitPath").value();
+    std::vector<pugi::xml_node> chain;
+    if (!type_ref.empty()) {
+      part.type = strip_alias(type_ref);
+      chain = class_chain(type_ref, unit_classes_, part.where);
+      if (!chain.empty() && std::find(used_types_.begin(), used_types_.end(), part.type) == used_types_.end()) {
+        used_types_.push_back(part.type);
+        type_chains_[part.type] = chain;
+      }
+    }
+
+    // Attributes: the class chain's, base first, then the instance's own on top.
+    std::map<std::string, pugi::xml_node> attributes;
+    for (auto c = chain.rbegin(); c != chain.rend(); ++c) {
+      for_each_child(*c, "Attribute", [&](const pugi::xml_node& a) { attributes[a.attribute("Name").value()] = a; });
+    }
+    std::map<std::string, pugi::xml_node> own_attributes;
+    for_each_child(element, "Attribute", [&](const pugi::xml_node& a) {
+      attributes[a.attribute("Name").value()] = a;
+      own_attributes[a.attribute("Name").value()] = a;
+    });
+
+    std::set<std::string> interface_names = declared_interfaces(chain);
+    for_each_child(element, "ExternalInterface", [&](const pugi::xml_node& i) {
+      const std::string name = i.attribute("Name").value();
+      interface_names.insert(name);
+      if (const std::string iid = i.attribute("ID").value(); !iid.empty()) {
+        register_id(i, normalize_id(iid));
+        interface_ids_[normalize_id(iid)] = {id, name};
+      }
+      std::optional<Frame> frame;
+      if (const auto f = frame_attribute(i)) frame = aml::parse_frame(f, file_);
+      part.interfaces[name] = frame;
+    });
+    // An instance Attribute named like an interface moves that interface for this part.
+    for (const auto& [name, attribute] : own_attributes) {
+      if (interface_names.count(name) && has_value(attribute)) {
+        part.interfaces[name] = aml::parse_point_attribute(attribute, file_);
+      }
+    }
+
+    for (const auto& [name, attribute] : attributes) {
+      if (interface_names.count(name) || name == "Frame") continue;
+      if (const auto text = aml::attribute_text(attribute)) part.attributes[name] = *text;
+    }
+    if (auto it = part.attributes.find("color"); it != part.attributes.end() && !it->second.empty()) {
+      part.color = it->second;
+    }
+    if (auto it = attributes.find("orientation"); it != attributes.end() && has_value(it->second)) {
+      part.orientation = aml::parse_orientation(it->second, file_);
+    } else if (auto frame = own_attributes.find("Frame"); frame != own_attributes.end()) {
+      part.orientation = aml::parse_frame(frame->second, file_).rotation;
+    }
+    part.mesh = find_mesh(element, chain);
+    out_.items_.emplace_back(std::move(part));
+  }
+
+  static bool has_value(const pugi::xml_node& attribute) {
+    const auto text = aml::attribute_text(attribute);
+    return text && !text->empty();
+  }
+
+  static pugi::xml_node frame_attribute(const pugi::xml_node& interface) {
+    for (pugi::xml_node a = interface.first_child(); a; a = a.next_sibling()) {
+      if (local_name(a) == "Attribute" && std::string_view(a.attribute("Name").value()) == "Frame") return a;
+    }
+    return {};
+  }
+
+  static std::set<std::string> declared_interfaces(const std::vector<pugi::xml_node>& chain) {
+    std::set<std::string> names;
+    for (const auto& c : chain) {
+      for_each_child(c, "ExternalInterface", [&](const pugi::xml_node& i) { names.insert(i.attribute("Name").value()); });
+    }
+    return names;
+  }
+
+  // The first geometry reference on the instance, else on its class chain (derived first).
+  std::optional<MeshRef> find_mesh(const pugi::xml_node& element, const std::vector<pugi::xml_node>& chain) const {
+    std::vector<pugi::xml_node> holders = {element};
+    holders.insert(holders.end(), chain.begin(), chain.end());
+    for (const auto& holder : holders) {
+      for (pugi::xml_node i = holder.first_child(); i; i = i.next_sibling()) {
+        if (local_name(i) != "ExternalInterface") continue;
+        pugi::xml_node uri_attribute;
+        for_each_child(i, "Attribute", [&](const pugi::xml_node& a) {
+          if (std::string_view(a.attribute("Name").value()) == "refURI") uri_attribute = a;
+        });
+        if (!uri_attribute) continue;
+        const std::string uri = aml::attribute_text(uri_attribute).value_or("");
+        if (!is_geometry_interface(i, uri)) continue;
+        return resolve_mesh(uri, file_.where(uri_attribute));
+      }
+    }
+    return std::nullopt;
+  }
+
+  MeshRef resolve_mesh(std::string uri, const SourceRef& where) const {
+    if (uri.empty()) throw DescriptionError(where, "geometry reference has an empty refURI");
+    if (const auto hash = uri.find('#'); hash != std::string::npos) uri.resize(hash);  // COLLADA node id
+    const bool has_scheme = uri.find("://") != std::string::npos || uri.rfind("file:", 0) == 0;
+    const std::filesystem::path relative(percent_decode(uri));
+    if (has_scheme || relative.is_absolute()) {
+      throw DescriptionError(where, "mesh reference '" + uri +
+                                        "' must be a path relative to the product's folder");
+    }
+    const auto folder = std::filesystem::weakly_canonical(std::filesystem::absolute(file_.path()).parent_path());
+    const auto file = std::filesystem::weakly_canonical(folder / relative);
+    const auto [f, _] = std::mismatch(folder.begin(), folder.end(), file.begin(), file.end());
+    if (f != folder.end()) {
+      throw DescriptionError(where, "mesh reference '" + uri + "' leaves the product's folder " + folder.string());
+    }
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) {
+      throw DescriptionError(where, "mesh file '" + uri + "' does not exist (looked for " + file.string() + ")");
+    }
+    return {file, where};
+  }
+
+  // --- type parameters (the paper's "parameter" items) ----------------------------------
+
+  void emit_type_parameters() {
+    for (const std::string& type : used_types_) {
+      const auto& chain = type_chains_.at(type);
+      const std::set<std::string> names = declared_interfaces(chain);
+      std::map<std::string, ParameterItem> parameters;
+      for (auto c = chain.rbegin(); c != chain.rend(); ++c) {  // base first; derived overrides
+        for_each_child(*c, "ExternalInterface", [&](const pugi::xml_node& i) {
+          ParameterItem& p = parameters[i.attribute("Name").value()];
+          p.type = type;
+          p.interface = i.attribute("Name").value();
+          p.where = file_.where(i);
+          if (const auto f = frame_attribute(i)) p.frame = aml::parse_frame(f, file_);
+        });
+        for_each_child(*c, "Attribute", [&](const pugi::xml_node& a) {
+          const std::string name = a.attribute("Name").value();
+          if (names.count(name) && has_value(a)) {
+            ParameterItem& p = parameters[name];
+            p.frame = aml::parse_point_attribute(a, file_);
+          }
+        });
+      }
+      for (auto& [_, p] : parameters) out_.items_.emplace_back(std::move(p));
+    }
+  }
+
+  // --- links -----------------------------------------------------------------------------
+
+  void read_link(const pugi::xml_node& link) {
+    const SourceRef where = file_.where(link);
+    ConnectionItem c;
+    c.name = link.attribute("Name").value();
+    c.where = where;
+    std::tie(c.part_a, c.interface_a) = link_side(link.attribute("RefPartnerSideA").value(), "RefPartnerSideA", where);
+    std::tie(c.part_b, c.interface_b) = link_side(link.attribute("RefPartnerSideB").value(), "RefPartnerSideB", where);
+    out_.items_.emplace_back(std::move(c));
+  }
+
+  // "<element ID>:<interface name>" (the paper's files) or a bare interface ID (CAEX 3.0
+  // editors). Returns the part ID and the interface name.
+  std::pair<std::string, std::string> link_side(const std::string& side, const std::string& attribute,
+                                                const SourceRef& where) const {
+    if (side.empty()) throw DescriptionError(where, attribute + " is missing");
+    const auto colon = side.find(':');
+    if (colon == std::string::npos) {
+      const auto it = interface_ids_.find(normalize_id(side));
+      if (it == interface_ids_.end()) {
+        throw DescriptionError(where, attribute + " '" + side + "' is neither <element ID>:<interface> nor the ID of a part's ExternalInterface");
+      }
+      return it->second;
+    }
+    const std::string id = normalize_id(side.substr(0, colon));
+    if (group_ids_.count(id)) {
+      throw DescriptionError(where, attribute + " '" + side + "' names an element that holds other elements (an assembly), not a part");
+    }
+    return {id, side.substr(colon + 1)};
+  }
+
+  const aml::XmlFile& file_;
+  AutomationMLDescription& out_;
+  std::unordered_map<std::string, pugi::xml_node> unit_classes_;
+  std::unordered_map<std::string, pugi::xml_node> interface_classes_;
+  std::vector<std::string> used_types_;
+  std::map<std::string, std::vector<pugi::xml_node>> type_chains_;
+  std::unordered_map<std::string, pugi::xml_node> ids_;
+  std::set<std::string> group_ids_;
+  std::unordered_map<std::string, std::pair<std::string, std::string>> interface_ids_;
+  std::vector<pugi::xml_node> links_;
+};
+
+AutomationMLDescription::AutomationMLDescription(const std::filesystem::path& file) : source_(file) {
+  const aml::XmlFile xml(file);
+  CaexReader(xml, *this).read();
+}
+
+}  // namespace twin

@@ -1,0 +1,43 @@
+#include "twin/description/product_description.hpp"
+
+namespace twin {
+namespace {
+
+struct ItemApplier {
+  Product& product;
+
+  void operator()(const CreatePartItem& item) const {
+    DigitalPart part;
+    part.id = item.id;
+    part.name = item.name;
+    part.type = item.type;
+    part.attributes = item.attributes;
+    part.color = item.color;
+    part.orientation = item.orientation;
+    part.mesh = item.mesh;
+    part.own_interfaces = item.interfaces;
+    part.where = item.where;
+    product.add_part(std::move(part));
+  }
+  void operator()(const ParameterItem& item) const {
+    product.set_type_interface(item.type, item.interface, item.frame);
+  }
+  void operator()(const ConnectionItem&) const {}
+};
+
+}  // namespace
+
+Product build_product(const ProductDescription& description) {
+  Product product(description.product_name(), description.source());
+  const std::vector<DescriptionItem> items = description.items();
+  // Connections last: a link may name a part declared further down the file.
+  for (const auto& item : items) std::visit(ItemApplier{product}, item);
+  for (const auto& item : items) {
+    if (const auto* c = std::get_if<ConnectionItem>(&item)) {
+      product.connect(c->part_a, c->interface_a, c->part_b, c->interface_b, c->name, c->where);
+    }
+  }
+  return product;
+}
+
+}  // namespace twin

@@ -1,0 +1,25 @@
+#pragma once
+// From a description file to the finished product: read, build, load meshes, place, set on
+// the assembly surface. Everything checked; a DescriptionError leaves nothing behind.
+
+#include <filesystem>
+#include <memory>
+
+#include "sim/mesh/triangle_mesh.hpp"
+#include "twin/description/product_description.hpp"
+#include "twin/geometry/placement.hpp"
+
+namespace twin {
+
+// Chooses the reader by file extension (.aml today).
+std::unique_ptr<ProductDescription> open_description(const std::filesystem::path& file);
+
+struct LoadedProduct {
+  Product product;
+  PartMeshes meshes;
+};
+
+LoadedProduct load_product(const std::filesystem::path& file, sim::MeshCache& cache,
+                           const PlacementOptions& options = {});
+
+}  // namespace twin
