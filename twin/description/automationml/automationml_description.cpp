@@ -78,6 +78,7 @@ class CaexReader {
     for_each_child(root, "InstanceHierarchy", [&](const pugi::xml_node& hierarchy) {
       any_hierarchy = true;
       if (out_.product_name_.empty()) out_.product_name_ = product_name_of(hierarchy);
+      collect_links(hierarchy);
       for_each_child(hierarchy, "InternalElement",
                      [&](const pugi::xml_node& e) { read_element(e); });
     });

@@ -23,8 +23,11 @@ XmlFile::XmlFile(const std::filesystem::path& path) : path_(path) {
   const pugi::xml_parse_result result = document_.load_buffer(
       text_.data(), text_.size(), pugi::parse_default | pugi::parse_doctype, pugi::encoding_utf8);
   if (!result) {
-    throw DescriptionError({path.string(), line_at(result.offset), ""},
-                           std::string("not well-formed XML: ") + result.description());
+    std::string message = std::string("not well-formed XML: ") + result.description();
+    if (result.offset + 1 >= static_cast<std::ptrdiff_t>(text_.size()) && result.status != pugi::status_no_document_element) {
+      message += " (the file ends in the middle of an element: truncated?)";
+    }
+    throw DescriptionError({path.string(), line_at(result.offset), ""}, message);
   }
   for (pugi::xml_node n = document_.first_child(); n; n = n.next_sibling()) {
     if (n.type() == pugi::node_doctype) {

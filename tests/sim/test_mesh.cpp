@@ -1,0 +1,34 @@
+#include <catch2/catch.hpp>
+
+#include "sim/mesh/triangle_mesh.hpp"
+
+namespace {
+std::filesystem::path data(const std::string& relative) { return std::filesystem::path(TEST_DATA_DIR) / relative; }
+std::filesystem::path products(const std::string& relative) { return std::filesystem::path(PRODUCTS_DIR) / relative; }
+}  // namespace
+
+TEST_CASE("meshes load from OBJ and STL in metres", "[mesh]") {
+  const auto plate = sim::load_mesh(data("good/meshes/plate.obj"));
+  CHECK(plate->triangles.size() == 12);
+  CHECK(plate->bounds.min().isApprox(Eigen::Vector3d(-0.02, 0, -0.02), 1e-6));
+  CHECK(plate->bounds.max().isApprox(Eigen::Vector3d(0.02, 0.01, 0.02), 1e-6));
+
+  const auto block = sim::load_mesh(data("good/meshes/block.stl"));
+  CHECK(block->triangles.size() == 12);
+  CHECK(block->bounds.sizes().isApprox(Eigen::Vector3d(0.01, 0.01, 0.01), 1e-6));
+}
+
+TEST_CASE("a mesh's objects are kept apart as convex pieces", "[mesh]") {
+  const auto faceplate = sim::load_mesh(products("cranfield/meshes/faceplate.obj"));
+  // 5 holes of 32 ring pieces each, plus the solid grid cells around them.
+  CHECK(faceplate->pieces.size() > 5 * 32);
+  CHECK(faceplate->bounds.sizes().isApprox(Eigen::Vector3d(0.240, 0.012, 0.180), 1e-6));
+  std::size_t vertices = 0;
+  for (const auto& piece : faceplate->pieces) vertices += piece.size();
+  CHECK(vertices == faceplate->vertices.size());
+}
+
+TEST_CASE("a file that is not a mesh is a MeshError", "[mesh]") {
+  CHECK_THROWS_AS(sim::load_mesh(data("bad/meshes/garbage.obj")), sim::MeshError);
+  CHECK_THROWS_AS(sim::load_mesh(data("bad/meshes/none.obj")), sim::MeshError);
+}

@@ -1,0 +1,41 @@
+#pragma once
+// Paths and helpers shared by the twin tests.
+
+#include <filesystem>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "sim/mesh/triangle_mesh.hpp"
+#include "twin/geometry/product_loader.hpp"
+
+namespace test {
+
+inline std::filesystem::path data(const std::string& relative) { return std::filesystem::path(TEST_DATA_DIR) / relative; }
+inline std::filesystem::path product(const std::string& relative) { return std::filesystem::path(PRODUCTS_DIR) / relative; }
+
+inline twin::LoadedProduct load(const std::filesystem::path& file) {
+  sim::MeshCache cache;
+  return twin::load_product(file, cache);
+}
+
+inline const twin::DigitalPart& part(const twin::Product& product, const std::string& name) {
+  const auto index = product.find_part_by_name(name);
+  REQUIRE(index.has_value());
+  return product.parts()[*index];
+}
+
+// Final position in millimetres, which is what the product files and docs speak in.
+inline twin::Vec3 position_mm(const twin::Product& product, const std::string& name) {
+  return part(product, name).final_pose.translation() * 1000.0;
+}
+
+}  // namespace test
+
+#define CHECK_VEC3(actual, ex, ey, ez)                     \
+  do {                                                  \
+    const twin::Vec3 v_ = (actual);                     \
+    CHECK(v_.x() == Approx(ex).margin(1e-6));            \
+    CHECK(v_.y() == Approx(ey).margin(1e-6));            \
+    CHECK(v_.z() == Approx(ez).margin(1e-6));            \
+  } while (0)
