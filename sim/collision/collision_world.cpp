@@ -1,0 +1,272 @@
+#include "sim/collision/collision_world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <btBulletCollisionCommon.h>
+
+namespace sim {
+namespace {
+
+// Bullet works in millimetres here: its GJK/EPA are tuned for bodies of 0.1 to 10 units, and
+// in metres a 15 mm peg gave penetration depths that were plainly wrong. The API stays in
+// metres; only this file sees Bullet units.
+constexpr double kUnitsPerMetre = 1000.0;
+
+btVector3 to_bullet(const Eigen::Vector3d& v) {
+  return btVector3(v.x() * kUnitsPerMetre, v.y() * kUnitsPerMetre, v.z() * kUnitsPerMetre);
+}
+
+btTransform to_bullet(const Pose& pose) {
+  const Eigen::Matrix3d r = pose.linear();
+  return btTransform(btMatrix3x3(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)),
+                     to_bullet(Eigen::Vector3d(pose.translation())));
+}
+
+}  // namespace
+
+// --- MovingBody ---------------------------------------------------------------------------
+
+struct MovingBody::Impl {
+  btCompoundShape compound{true};
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::string> member_of_child;  // compound child index -> member name
+  btCollisionObject object;
+
+  Impl() { object.setCollisionShape(&compound); }
+  void add(const std::string& member, std::unique_ptr<btCollisionShape> shape, const Pose& offset) {
+    compound.addChildShape(to_bullet(offset), shape.get());
+    member_of_child.push_back(member);
+    shapes.push_back(std::move(shape));
+  }
+};
+
+MovingBody::MovingBody() : impl_(std::make_unique<Impl>()) {}
+MovingBody::~MovingBody() = default;
+MovingBody::MovingBody(MovingBody&& other) noexcept = default;
+MovingBody& MovingBody::operator=(MovingBody&& other) noexcept = default;
+
+void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin) {
+  for (const auto& piece : mesh.pieces) {
+    auto hull = std::make_unique<btConvexHullShape>();
+    for (auto index : piece) {
+      const Eigen::Vector3d& v = mesh.vertices[index];
+      hull->addPoint(to_bullet(v), false);
+      radius_ = std::max(radius_, (offset * v).norm());
+    }
+    hull->recalcLocalAabb();
+    hull->setMargin(margin * kUnitsPerMetre);
+    impl_->add(member, std::move(hull), offset);
+  }
+}
+
+void MovingBody::add_box(const std::string& member, const Eigen::Vector3d& half_extents, const Pose& offset,
+                         double margin) {
+  auto box = std::make_unique<btBoxShape>(to_bullet(half_extents));
+  box->setMargin(margin * kUnitsPerMetre);
+  radius_ = std::max(radius_, offset.translation().norm() + half_extents.norm());
+  impl_->add(member, std::move(box), offset);
+}
+
+// --- CollisionWorld -----------------------------------------------------------------------
+
+struct CollisionWorld::Impl {
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher{&configuration};
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world{&dispatcher, &broadphase, &configuration};
+
+  struct SharedMesh {
+    std::shared_ptr<const TriangleMesh> mesh;
+    std::vector<float> vertices;
+    std::vector<int> indices;
+    std::unique_ptr<btTriangleIndexVertexArray> array;
+    std::unique_ptr<btCollisionShape> shape;
+    std::vector<std::unique_ptr<btCollisionShape>> hulls;
+  };
+  std::map<const TriangleMesh*, SharedMesh> meshes;
+  struct Body {
+    std::string name;
+    std::unique_ptr<btCollisionShape> own_shape;  // boxes; meshes share theirs
+    std::unique_ptr<btCollisionObject> object;
+  };
+  std::map<BodyId, Body> bodies;
+  BodyId next_id = 0;
+
+  // A mesh authored as convex pieces becomes a compound of their hulls: holes stay open and
+  // penetration depths are those of convex pairs. A one-piece mesh may be concave, so it
+  // becomes a triangle BVH (whose depths are per triangle, less exact for thin walls).
+  btCollisionShape* static_shape_for(std::shared_ptr<const TriangleMesh> mesh, double margin) {
+    auto [it, inserted] = meshes.try_emplace(mesh.get());
+    SharedMesh& shared = it->second;
+    if (!inserted) return shared.shape.get();
+    shared.mesh = mesh;
+    if (mesh->pieces.size() > 1) {
+      auto compound = std::make_unique<btCompoundShape>(true, static_cast<int>(mesh->pieces.size()));
+      for (const auto& piece : mesh->pieces) {
+        auto hull = std::make_unique<btConvexHullShape>();
+        for (auto index : piece) hull->addPoint(to_bullet(mesh->vertices[index]), false);
+        hull->recalcLocalAabb();
+        hull->setMargin(margin * kUnitsPerMetre);
+        compound->addChildShape(btTransform::getIdentity(), hull.get());
+        shared.hulls.push_back(std::move(hull));
+      }
+      shared.shape = std::move(compound);
+      return shared.shape.get();
+    }
+    for (const auto& v : mesh->vertices) {
+      const btVector3 b = to_bullet(v);
+      shared.vertices.insert(shared.vertices.end(), {float(b.x()), float(b.y()), float(b.z())});
+    }
+    for (const auto& t : mesh->triangles) shared.indices.insert(shared.indices.end(), {int(t[0]), int(t[1]), int(t[2])});
+    shared.array = std::make_unique<btTriangleIndexVertexArray>(
+        static_cast<int>(mesh->triangles.size()), shared.indices.data(), 3 * sizeof(int),
+        static_cast<int>(mesh->vertices.size()), shared.vertices.data(), 3 * sizeof(float));
+    auto bvh = std::make_unique<btBvhTriangleMeshShape>(shared.array.get(), true);
+    bvh->setMargin(margin * kUnitsPerMetre);
+    shared.shape = std::move(bvh);
+    return shared.shape.get();
+  }
+
+  BodyId add(const std::string& name, btCollisionShape* shape, std::unique_ptr<btCollisionShape> own, const Pose& pose) {
+    auto object = std::make_unique<btCollisionObject>();
+    object->setCollisionShape(shape);
+    object->setWorldTransform(to_bullet(pose));
+    object->setUserIndex(next_id);
+    world.addCollisionObject(object.get());
+    bodies[next_id] = Body{name, std::move(own), std::move(object)};
+    return next_id++;
+  }
+};
+
+namespace {
+
+// Keeps the deepest penetration beyond the tolerance.
+struct DeepestContact : btCollisionWorld::ContactResultCallback {
+  const btCollisionObject* self;
+  double tolerance;
+  std::optional<Contact> deepest;
+  int self_child = -1;
+
+  DeepestContact(const btCollisionObject* s, double t) : self(s), tolerance(t) {}
+
+  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper* a, int, int,
+                           const btCollisionObjectWrapper* b, int, int) override {
+    const double depth = -cp.getDistance() / kUnitsPerMetre;
+    if (depth <= tolerance || (deepest && depth <= deepest->depth)) return 0;
+    const bool self_is_a = a->getCollisionObject() == self;
+    const btCollisionObject* other = self_is_a ? b->getCollisionObject() : a->getCollisionObject();
+    Contact c;
+    c.body = other->getUserIndex();
+    c.depth = depth;
+    const btVector3 p = self_is_a ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
+    c.point = Eigen::Vector3d(p.x(), p.y(), p.z()) / kUnitsPerMetre;
+    self_child = self_is_a ? a->m_index : b->m_index;
+    deepest = c;
+    return 0;
+  }
+};
+
+}  // namespace
+
+CollisionWorld::CollisionWorld(CollisionOptions options) : impl_(std::make_unique<Impl>()), options_(options) {}
+CollisionWorld::~CollisionWorld() {
+  for (auto& [id, body] : impl_->bodies) impl_->world.removeCollisionObject(body.object.get());
+}
+
+BodyId CollisionWorld::add_static_mesh(const std::string& name, std::shared_ptr<const TriangleMesh> mesh, const Pose& pose) {
+  return impl_->add(name, impl_->static_shape_for(std::move(mesh), options_.shape_margin), nullptr, pose);
+}
+
+BodyId CollisionWorld::add_static_box(const std::string& name, const Eigen::Vector3d& half_extents, const Pose& pose) {
+  auto box = std::make_unique<btBoxShape>(to_bullet(half_extents));
+  box->setMargin(options_.shape_margin * kUnitsPerMetre);
+  btCollisionShape* shape = box.get();
+  return impl_->add(name, shape, std::move(box), pose);
+}
+
+void CollisionWorld::remove(BodyId body) {
+  const auto it = impl_->bodies.find(body);
+  if (it == impl_->bodies.end()) return;
+  impl_->world.removeCollisionObject(it->second.object.get());
+  impl_->bodies.erase(it);
+}
+
+std::size_t CollisionWorld::body_count() const { return impl_->bodies.size(); }
+
+std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const Pose& pose) const {
+  ++checks_;
+  btCollisionObject& object = body.impl_->object;
+  object.setWorldTransform(to_bullet(pose));
+  DeepestContact callback(&object, options_.contact_tolerance);
+  impl_->world.contactTest(&object, callback);
+  if (!callback.deepest) return std::nullopt;
+  Contact c = *callback.deepest;
+  c.body_name = impl_->bodies.at(c.body).name;
+  const auto& members = body.impl_->member_of_child;
+  if (callback.self_child >= 0 && callback.self_child < static_cast<int>(members.size())) {
+    c.member = members[callback.self_child];
+  }
+  return c;
+}
+
+namespace {
+
+struct AnyOverlap : btBroadphaseAabbCallback {
+  bool found = false;
+  bool process(const btBroadphaseProxy*) override {
+    found = true;
+    return false;
+  }
+};
+
+Pose interpolate(const Pose& from, const Pose& to, double s) {
+  Pose pose = Pose::Identity();
+  pose.linear() = Eigen::Quaterniond(from.linear()).slerp(s, Eigen::Quaterniond(to.linear())).toRotationMatrix();
+  pose.translation() = (1 - s) * from.translation() + s * to.translation();
+  return pose;
+}
+
+}  // namespace
+
+// Recursive: a stretch of the sweep whose bounding box (both ends, padded for turning)
+// overlaps no body is free as a whole; the rest is halved down to linear_step and sampled.
+// Samples go in order along the sweep, so the first collision is the one reported.
+std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose& from, const Pose& to) const {
+  const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
+  const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
+  const btCollisionShape& shape = body.impl_->compound;
+  const double pad = (angle * body.radius() + options_.shape_margin) * kUnitsPerMetre;
+
+  std::optional<Contact> hit;
+  auto visit = [&](auto&& self, double s0, double s1, bool check_start) -> bool {
+    const Pose a = interpolate(from, to, s0), b = interpolate(from, to, s1);
+    btVector3 min_a, max_a, min_b, max_b;
+    shape.getAabb(to_bullet(a), min_a, max_a);
+    shape.getAabb(to_bullet(b), min_b, max_b);
+    min_a.setMin(min_b);
+    max_a.setMax(max_b);
+    const btVector3 padding(pad * (s1 - s0), pad * (s1 - s0), pad * (s1 - s0));
+    AnyOverlap overlap;
+    impl_->broadphase.aabbTest(min_a - padding, max_a + padding, overlap);
+    if (!overlap.found) return false;
+    if ((s1 - s0) * travel <= options_.linear_step) {
+      for (auto [s, pose] : {std::pair{s0, a}, std::pair{s1, b}}) {
+        if (s == s0 && !check_start) continue;
+        if (auto contact = penetration(body, pose)) {
+          contact->fraction = s;
+          hit = contact;
+          return true;
+        }
+      }
+      return false;
+    }
+    const double mid = (s0 + s1) / 2;
+    return self(self, s0, mid, check_start) || self(self, mid, s1, false);
+  };
+  visit(visit, 0.0, 1.0, true);
+  return hit;
+}
+
+}  // namespace sim

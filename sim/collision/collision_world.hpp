@@ -1,0 +1,91 @@
+#pragma once
+// The collision world: static bodies (assembled parts, concave: a compound of the mesh's
+// convex pieces, or a triangle-mesh BVH for a one-piece mesh, so that a peg can pass
+// through a hole; the station's surface as a box) and moving bodies (a compound of
+// convex pieces: the gripped part's convex decomposition plus the gripper and carriage).
+// Touching is not colliding: only penetration deeper than the contact tolerance counts.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sim/mesh/triangle_mesh.hpp"
+
+namespace sim {
+
+using Pose = Eigen::Isometry3d;
+using BodyId = int;
+
+struct CollisionOptions {
+  double contact_tolerance = 3e-4;  // m: deeper penetration than this is a collision
+  double linear_step = 1e-3;        // m: largest move of any point between swept samples
+  double shape_margin = 5e-5;       // m: Bullet's collision margin on every shape
+};
+
+struct Contact {
+  BodyId body = -1;         // the static body hit
+  std::string body_name;
+  std::string member;       // which member of the moving body: "part", "gripper", ...
+  double depth = 0;         // m, positive
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double fraction = 0;      // where along a sweep, 0..1
+};
+
+class CollisionWorld;
+
+// Something that moves: named members, each a convex decomposition at an offset.
+class MovingBody {
+ public:
+  MovingBody();
+  ~MovingBody();
+  MovingBody(MovingBody&&) noexcept;
+  MovingBody& operator=(MovingBody&&) noexcept;
+
+  // Each piece of the mesh becomes one convex hull (a mesh with one piece: its hull).
+  void add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin);
+  void add_box(const std::string& member, const Eigen::Vector3d& half_extents, const Pose& offset, double margin);
+  // Largest distance of any point from the body's origin: bounds how far points move when
+  // it turns.
+  double radius() const { return radius_; }
+
+ private:
+  friend class CollisionWorld;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  double radius_ = 0;
+};
+
+class CollisionWorld {
+ public:
+  explicit CollisionWorld(CollisionOptions options = {});
+  ~CollisionWorld();
+  CollisionWorld(const CollisionWorld&) = delete;
+  CollisionWorld& operator=(const CollisionWorld&) = delete;
+
+  const CollisionOptions& options() const { return options_; }
+
+  // A concave static body; bodies of one mesh share one shape.
+  BodyId add_static_mesh(const std::string& name, std::shared_ptr<const TriangleMesh> mesh, const Pose& pose);
+  BodyId add_static_box(const std::string& name, const Eigen::Vector3d& half_extents, const Pose& pose);
+  void remove(BodyId body);
+  std::size_t body_count() const;
+
+  // The deepest penetration of the body at a pose, if deeper than the tolerance.
+  std::optional<Contact> penetration(const MovingBody& body, const Pose& pose) const;
+  // The first collision while moving from one pose to another, translating and turning
+  // together (slerp), sampled so that no point moves more than linear_step between samples.
+  std::optional<Contact> sweep(const MovingBody& body, const Pose& from, const Pose& to) const;
+  // Penetration tests made so far (for benchmarks).
+  std::size_t checks() const { return checks_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  CollisionOptions options_;
+  mutable std::size_t checks_ = 0;
+};
+
+}  // namespace sim
