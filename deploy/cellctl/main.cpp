@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "deploy/cellctl/describe_command.hpp"
+#include "deploy/cellctl/plan_command.hpp"
 #include "twin/model/source_ref.hpp"
 
 int main(int argc, char** argv) {
@@ -13,9 +14,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   int exit_code = 0;
   cellctl::add_describe_command(app, exit_code);
+  cellctl::add_plan_command(app, exit_code);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);

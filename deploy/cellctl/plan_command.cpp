@@ -1,0 +1,47 @@
+#include "deploy/cellctl/plan_command.hpp"
+
+#include <fstream>
+#include <iostream>
+
+#include "deploy/cellctl/plan_report.hpp"
+#include "twin/geometry/product_loader.hpp"
+
+namespace cellctl {
+
+void add_plan_command(CLI::App& app, int& exit_code) {
+  struct Options {
+    std::string product;
+    std::string sequence = "search";
+    std::string path = "linear";
+    std::string json;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("plan", "Plan and validate the assembly by virtual assembly");
+  cmd->add_option("PRODUCT", options->product, "AutomationML file (.aml)")->required();
+  cmd->add_option("--sequence", options->sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
+  cmd->add_option("--path", options->path, "Path planner")->check(CLI::IsMember({"linear"}));
+  cmd->add_option("--json", options->json, "Write the plan as JSON to this file");
+  cmd->callback([options, &exit_code] {
+    sim::MeshCache meshes;
+    const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
+    for (std::size_t i = 0; i < loaded.meshes.size(); ++i) {
+      if (!loaded.meshes[i]) {
+        const auto& part = loaded.product.parts()[i];
+        throw twin::DescriptionError(part.where, "part '" + part.name + "' has no geometry to plan with");
+      }
+    }
+    auto sequence = twin::make_sequence_planner(options->sequence);
+    auto path = twin::make_path_planner(options->path);
+    const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path);
+    print_plan(loaded.product, plan, std::cout);
+    if (!options->json.empty()) {
+      std::ofstream out(options->json);
+      out << plan_json(loaded.product, plan).dump(2) << '\n';
+      if (!out) throw std::runtime_error("cannot write " + options->json);
+      std::cout << "\nwrote " << options->json << '\n';
+    }
+    exit_code = plan.complete ? 0 : 1;
+  });
+}
+
+}  // namespace cellctl

@@ -1,0 +1,10 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace cellctl {
+
+// cellctl plan PRODUCT.aml [--sequence paper|search] [--path linear] [--json FILE]
+void add_plan_command(CLI::App& app, int& exit_code);
+
+}  // namespace cellctl

@@ -1,0 +1,128 @@
+// Virtual assembly planning on the case studies and on products made to need backtracking
+// or to be impossible.
+
+#include <algorithm>
+
+#include "tests/twin/test_support.hpp"
+#include "twin/planning/assembly_planner.hpp"
+
+namespace {
+
+twin::Plan plan(const std::filesystem::path& file, const std::string& sequence, sim::MeshCache& cache,
+                twin::LoadedProduct& loaded) {
+  loaded = twin::load_product(file, cache);
+  auto s = twin::make_sequence_planner(sequence);
+  auto p = twin::make_path_planner("linear");
+  return twin::plan_assembly(loaded, *s, *p);
+}
+
+std::vector<std::string> order(const twin::LoadedProduct& loaded, const twin::Plan& plan) {
+  std::vector<std::string> names;
+  for (const auto& step : plan.steps) names.push_back(loaded.product.parts()[step.part].name);
+  return names;
+}
+
+std::size_t at(const std::vector<std::string>& order, const std::string& name) {
+  const auto it = std::find(order.begin(), order.end(), name);
+  REQUIRE(it != order.end());
+  return static_cast<std::size_t>(it - order.begin());
+}
+
+bool has_finding(const twin::Plan& plan, const std::string& kind, const std::string& fragment) {
+  return std::any_of(plan.findings.begin(), plan.findings.end(), [&](const twin::Finding& f) {
+    return f.kind == kind && f.message.find(fragment) != std::string::npos;
+  });
+}
+
+}  // namespace
+
+TEST_CASE("Cranfield: back first, shaft before pendulum, square pegs before separator, front last", "[planning][cranfield]") {
+  for (const char* sequence : {"paper", "search"}) {
+    SECTION(sequence) {
+      sim::MeshCache cache;
+      twin::LoadedProduct loaded{twin::Product("", ""), {}};
+      const twin::Plan p = plan(test::product("cranfield/cranfield.aml"), sequence, cache, loaded);
+      REQUIRE(p.complete);
+      const auto o = order(loaded, p);
+      CHECK(o.front() == "back");
+      CHECK(o.back() == "front");
+      CHECK(at(o, "shaft") < at(o, "pendulum"));
+      CHECK(at(o, "boltA1") < at(o, "separator"));
+      CHECK(at(o, "boltA2") < at(o, "separator"));
+      for (const auto& step : p.steps) {
+        const auto& name = loaded.product.parts()[step.part].name;
+        if (name.rfind("bolt", 0) == 0) {
+          INFO(name);
+          CHECK(step.trajectory.label == "down");
+          CHECK(step.trajectory.direction.isApprox(-twin::Vec3::UnitY()));
+          CHECK(step.failed.empty());
+        }
+      }
+      // The links leave the bolts' order open: the designer is told.
+      CHECK(has_finding(p, "open-order", "boltR1"));
+    }
+  }
+}
+
+TEST_CASE("Lego tower: bottom-up; the hanging brick goes in sideways after a collision", "[planning][lego]") {
+  for (const char* sequence : {"paper", "search"}) {
+    SECTION(sequence) {
+      sim::MeshCache cache;
+      twin::LoadedProduct loaded{twin::Product("", ""), {}};
+      const twin::Plan p = plan(test::product("lego-tower/lego-tower.aml"), sequence, cache, loaded);
+      REQUIRE(p.complete);
+      // Bottom-up: no brick is assembled before one it stands on.
+      for (std::size_t i = 1; i < p.steps.size(); ++i) {
+        const auto& part = loaded.product.parts()[p.steps[i].part];
+        if (part.name == "hanging") continue;
+        CHECK(part.final_pose.translation().y() >=
+              loaded.product.parts()[p.steps[i - 1].part].final_pose.translation().y() - 1e-9);
+      }
+      const auto o = order(loaded, p);
+      CHECK(at(o, "overhang") < at(o, "hanging"));
+      const auto& hanging = p.steps[at(o, "hanging")];
+      REQUIRE_FALSE(hanging.failed.empty());
+      CHECK(hanging.failed.front().trajectory.label == "down");
+      CHECK(hanging.failed.front().collision->with == "overhang");
+      CHECK(std::abs(hanging.trajectory.direction.y()) < 1e-9);  // from the side
+      CHECK(has_finding(p, "collision", "hanging (down): part hit overhang"));
+    }
+  }
+}
+
+TEST_CASE("backtracking: the paper heuristic stops where the search planner finishes", "[planning][backtrack]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan paper = plan(test::data("planning/backtrack/backtrack.aml"), "paper", cache, loaded);
+  CHECK_FALSE(paper.complete);
+  CHECK(order(loaded, paper) == std::vector<std::string>{"base", "cap"});
+  CHECK(has_finding(paper, "infeasible", "block: no collision-free path; blocked by cap"));
+
+  const twin::Plan search = plan(test::data("planning/backtrack/backtrack.aml"), "search", cache, loaded);
+  REQUIRE(search.complete);
+  CHECK(order(loaded, search) == std::vector<std::string>{"base", "block", "cap"});
+  CHECK(search.backtracks == 1);
+  CHECK(has_finding(search, "backtrack", "cap"));
+}
+
+TEST_CASE("a product no order can build is reported with what blocks what", "[planning][impossible]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan p = plan(test::data("planning/impossible/impossible.aml"), "search", cache, loaded);
+  CHECK_FALSE(p.complete);
+  CHECK(has_finding(p, "infeasible", "block: no collision-free path; blocked by shell"));
+}
+
+TEST_CASE("the same input gives the same plan", "[planning][determinism]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct a{twin::Product("", ""), {}}, b{twin::Product("", ""), {}};
+  const twin::Plan first = plan(test::product("lego-tower/lego-tower.aml"), "search", cache, a);
+  const twin::Plan second = plan(test::product("lego-tower/lego-tower.aml"), "search", cache, b);
+  REQUIRE(first.steps.size() == second.steps.size());
+  for (std::size_t i = 0; i < first.steps.size(); ++i) {
+    CHECK(first.steps[i].part == second.steps[i].part);
+    CHECK(first.steps[i].trajectory.label == second.steps[i].trajectory.label);
+    CHECK(first.steps[i].trajectory.path_length() == second.steps[i].trajectory.path_length());
+  }
+  CHECK(first.findings.size() == second.findings.size());
+}

@@ -1,0 +1,47 @@
+#pragma once
+// Virtual assembly planning (paper Fig. 5): ask the sequence planner for the next part, the
+// path planner for a trajectory, run it in the collision world; on a collision ask for
+// another trajectory; when no candidate part can be inserted, take parts off again and try
+// another order (if the sequence planner backtracks). The result is a plan and findings
+// for the designer.
+
+#include <string>
+#include <vector>
+
+#include "twin/planning/path_planner.hpp"
+#include "twin/planning/sequence_planner.hpp"
+
+namespace twin {
+
+struct PlanStep {
+  PartIndex part = 0;
+  Trajectory trajectory;
+  std::vector<Attempt> failed;  // collided tries before the one that worked
+};
+
+struct Finding {
+  std::string kind;  // "collision", "backtrack", "open-order", "infeasible", "gave-up"
+  std::string message;
+  std::vector<std::string> parts;
+};
+
+struct Plan {
+  bool complete = false;
+  std::vector<PlanStep> steps;
+  std::vector<Finding> findings;
+  std::string sequence_planner;
+  std::string path_planner;
+  std::size_t backtracks = 0;
+  std::size_t trajectories_simulated = 0;
+};
+
+struct PlannerOptions {
+  std::size_t max_backtracks = 10000;  // bounds the search on products that cannot be built
+  sim::CollisionOptions collision;
+  ArmGeometry arm;
+};
+
+Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
+                   const PlannerOptions& options = {});
+
+}  // namespace twin

@@ -1,0 +1,115 @@
+#include "twin/planning/assembly_scene.hpp"
+
+namespace twin {
+namespace {
+
+// Index and sign of a direction's dominant axis.
+std::pair<int, double> dominant_axis(const Vec3& direction) {
+  int axis = 0;
+  direction.cwiseAbs().maxCoeff(&axis);
+  return {axis, direction[axis] > 0 ? 1.0 : -1.0};
+}
+
+Pose translation(const Vec3& t) {
+  Pose p = Pose::Identity();
+  p.translation() = t;
+  return p;
+}
+
+}  // namespace
+
+AssemblyScene::AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options, ArmGeometry arm)
+    : product_(product), arm_(arm), world_(options) {
+  const auto& parts = product.product.parts();
+  for (PartIndex i = 0; i < parts.size(); ++i) {
+    Eigen::AlignedBox3d box;
+    if (const auto& mesh = product.meshes[i]) {
+      for (const auto& v : mesh->vertices) box.extend(parts[i].final_pose * v);
+    } else {
+      box.extend(parts[i].final_pose.translation());
+    }
+    bounds_.push_back(box);
+  }
+  // The station's surface: a slab whose top is the assembly surface, y = 0.
+  const sim::BodyId station = world_.add_static_box("station", Vec3(1.0, 0.025, 1.0), translation(Vec3(0, -0.025, 0)));
+  names_[station] = "station";
+}
+
+void AssemblyScene::assemble(PartIndex part) {
+  if (is_assembled(part)) return;
+  const auto& p = product_.product.parts()[part];
+  const sim::BodyId id = world_.add_static_mesh(p.name, product_.meshes[part], p.final_pose);
+  bodies_[part] = id;
+  names_[id] = p.name;
+}
+
+void AssemblyScene::disassemble(PartIndex part) {
+  const auto it = bodies_.find(part);
+  if (it == bodies_.end()) return;
+  world_.remove(it->second);
+  names_.erase(it->second);
+  bodies_.erase(it);
+}
+
+Eigen::AlignedBox3d AssemblyScene::assembled_bounds() const {
+  Eigen::AlignedBox3d box;
+  for (const auto& [part, _] : bodies_) box.extend(bounds_[part]);
+  return box;
+}
+
+Eigen::Vector3d AssemblyScene::pad_half_extents(PartIndex part, const Vec3& direction) const {
+  const int axis = dominant_axis(direction).first;
+  Eigen::Vector3d half = bounds_[part].sizes().cwiseMin(arm_.pad_max_width) / 2;
+  half[axis] = arm_.pad_thickness / 2;
+  return half;
+}
+
+Pose AssemblyScene::grip_offset(PartIndex part, const Vec3& direction) const {
+  const auto [axis, sign] = dominant_axis(direction);
+  const Eigen::AlignedBox3d& box = bounds_[part];
+  Vec3 centre = box.center();
+  // The face behind the part: the pad pushes it along `direction`.
+  centre[axis] = (sign > 0 ? box.min()[axis] : box.max()[axis]) - sign * arm_.pad_thickness / 2;
+  return product_.product.parts()[part].final_pose.inverse() * translation(centre);
+}
+
+std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {
+  const auto& w = trajectory.waypoints;
+  if (w.empty()) return std::nullopt;
+  const Vec3 d = trajectory.direction;
+  const auto [axis, sign] = dominant_axis(d);
+  const Eigen::Vector3d pad = pad_half_extents(part, d);
+  Eigen::Vector3d carriage = Eigen::Vector3d::Constant(arm_.carriage_width / 2);
+  carriage[axis] = arm_.carriage_length / 2;
+  // In the gripper's frame (world-aligned at the final pose): the carriage runs away from
+  // the part, behind the pad.
+  Vec3 carriage_offset = Vec3::Zero();
+  carriage_offset[axis] = -sign * (arm_.pad_thickness / 2 + arm_.carriage_length / 2);
+
+  const double margin = world_.options().shape_margin;
+  const Pose grip = w.front().part.inverse() * w.front().gripper;
+  sim::MovingBody held;
+  if (const auto& mesh = product_.meshes[part]) held.add_mesh("part", *mesh, Pose::Identity(), margin);
+  held.add_box("gripper", pad, grip, margin);
+  held.add_box("carriage", carriage, grip * translation(carriage_offset), margin);
+  sim::MovingBody arm;
+  arm.add_box("gripper", pad, Pose::Identity(), margin);
+  arm.add_box("carriage", carriage, translation(carriage_offset), margin);
+
+  if (w.front().holding) {
+    if (auto c = world_.penetration(held, w.front().part)) return to_collision(*c, w.front().phase);
+  }
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    const auto contact = w[i].holding ? world_.sweep(held, w[i - 1].part, w[i].part)
+                                      : world_.sweep(arm, w[i - 1].gripper, w[i].gripper);
+    if (contact) return to_collision(*contact, w[i].phase);
+  }
+  return std::nullopt;
+}
+
+Collision AssemblyScene::to_collision(const sim::Contact& contact, const std::string& phase) const {
+  const auto it = names_.find(contact.body);
+  return {it == names_.end() ? contact.body_name : it->second, contact.member, contact.depth, phase};
+}
+
+}  // namespace twin
