@@ -19,7 +19,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand("plan", "Plan and validate the assembly by virtual assembly");
   cmd->add_option("PRODUCT", options->product, "AutomationML file (.aml)")->required();
   cmd->add_option("--sequence", options->sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
-  cmd->add_option("--path", options->path, "Path planner")->check(CLI::IsMember({"linear"}));
+  cmd->add_option("--path", options->path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   cmd->add_option("--json", options->json, "Write the plan as JSON to this file");
   cmd->callback([options, &exit_code] {
     sim::MeshCache meshes;

@@ -9,10 +9,10 @@
 namespace {
 
 twin::Plan plan(const std::filesystem::path& file, const std::string& sequence, sim::MeshCache& cache,
-                twin::LoadedProduct& loaded) {
+                twin::LoadedProduct& loaded, const std::string& path = "linear") {
   loaded = twin::load_product(file, cache);
   auto s = twin::make_sequence_planner(sequence);
-  auto p = twin::make_path_planner("linear");
+  auto p = twin::make_path_planner(path);
   return twin::plan_assembly(loaded, *s, *p);
 }
 
@@ -125,4 +125,29 @@ TEST_CASE("the same input gives the same plan", "[planning][determinism]") {
     CHECK(first.steps[i].trajectory.path_length() == second.steps[i].trajectory.path_length());
   }
   CHECK(first.findings.size() == second.findings.size());
+}
+
+TEST_CASE("no straight insertion: OMPL's RRT-Connect finds a path, checked in the collision world", "[planning][ompl]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan linear = plan(test::data("planning/ledge/ledge.aml"), "search", cache, loaded, "linear");
+  CHECK_FALSE(linear.complete);
+  CHECK(has_finding(linear, "infeasible", "block: no collision-free path"));
+
+  const twin::Plan sampled = plan(test::data("planning/ledge/ledge.aml"), "search", cache, loaded, "ompl");
+  REQUIRE(sampled.complete);
+  const auto& step = sampled.steps.back();
+  CHECK(loaded.product.parts()[step.part].name == "block");
+  CHECK(step.trajectory.label == "ompl");
+  CHECK(step.failed.size() == 6);  // every straight insertion collided first
+  CHECK(step.trajectory.waypoints.size() >= 4);
+  // It ends exactly at the part's place, and the whole path is free when run again.
+  CHECK(step.trajectory.waypoints.back().part.translation().isApprox(
+      loaded.product.parts()[step.part].final_pose.translation()));
+  twin::AssemblyScene scene(loaded);
+  for (const auto& s : sampled.steps) {
+    if (&s == &step) break;
+    scene.assemble(s.part);
+  }
+  CHECK_FALSE(scene.simulate(step.part, step.trajectory));
 }

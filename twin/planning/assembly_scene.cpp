@@ -73,12 +73,9 @@ Pose AssemblyScene::grip_offset(PartIndex part, const Vec3& direction) const {
   return product_.product.parts()[part].final_pose.inverse() * translation(centre);
 }
 
-std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {
-  const auto& w = trajectory.waypoints;
-  if (w.empty()) return std::nullopt;
-  const Vec3 d = trajectory.direction;
-  const auto [axis, sign] = dominant_axis(d);
-  const Eigen::Vector3d pad = pad_half_extents(part, d);
+HeldPart AssemblyScene::hold(PartIndex part, const Vec3& direction) const {
+  const auto [axis, sign] = dominant_axis(direction);
+  const Eigen::Vector3d pad = pad_half_extents(part, direction);
   Eigen::Vector3d carriage = Eigen::Vector3d::Constant(arm_.carriage_width / 2);
   carriage[axis] = arm_.carriage_length / 2;
   // In the gripper's frame (world-aligned at the final pose): the carriage runs away from
@@ -87,21 +84,32 @@ std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajector
   carriage_offset[axis] = -sign * (arm_.pad_thickness / 2 + arm_.carriage_length / 2);
 
   const double margin = world_.options().shape_margin;
-  const Pose grip = w.front().part.inverse() * w.front().gripper;
-  sim::MovingBody held;
-  if (const auto& mesh = product_.meshes[part]) held.add_mesh("part", *mesh, Pose::Identity(), margin);
-  held.add_box("gripper", pad, grip, margin);
-  held.add_box("carriage", carriage, grip * translation(carriage_offset), margin);
-  sim::MovingBody arm;
-  arm.add_box("gripper", pad, Pose::Identity(), margin);
-  arm.add_box("carriage", carriage, translation(carriage_offset), margin);
+  HeldPart held;
+  held.grip = grip_offset(part, direction);
+  if (const auto& mesh = product_.meshes[part]) held.with_arm.add_mesh("part", *mesh, Pose::Identity(), margin);
+  held.with_arm.add_box("gripper", pad, held.grip, margin);
+  held.with_arm.add_box("carriage", carriage, held.grip * translation(carriage_offset), margin);
+  held.arm.add_box("gripper", pad, Pose::Identity(), margin);
+  held.arm.add_box("carriage", carriage, translation(carriage_offset), margin);
+  return held;
+}
 
+std::optional<Collision> AssemblyScene::collision_at(const sim::MovingBody& body, const Pose& pose,
+                                                     const std::string& phase) const {
+  if (auto c = world_.penetration(body, pose)) return to_collision(*c, phase);
+  return std::nullopt;
+}
+
+std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {
+  const auto& w = trajectory.waypoints;
+  if (w.empty()) return std::nullopt;
+  const HeldPart held = hold(part, trajectory.grip_direction);
   if (w.front().holding) {
-    if (auto c = world_.penetration(held, w.front().part)) return to_collision(*c, w.front().phase);
+    if (auto c = collision_at(held.with_arm, w.front().part, w.front().phase)) return c;
   }
   for (std::size_t i = 1; i < w.size(); ++i) {
-    const auto contact = w[i].holding ? world_.sweep(held, w[i - 1].part, w[i].part)
-                                      : world_.sweep(arm, w[i - 1].gripper, w[i].gripper);
+    const auto contact = w[i].holding ? world_.sweep(held.with_arm, w[i - 1].part, w[i].part)
+                                      : world_.sweep(held.arm, w[i - 1].gripper, w[i].gripper);
     if (contact) return to_collision(*contact, w[i].phase);
   }
   return std::nullopt;

@@ -27,6 +27,13 @@ struct Collision {
   std::string phase;    // of the trajectory
 };
 
+// The part in the gripper, as the collision world sees it.
+struct HeldPart {
+  sim::MovingBody with_arm;  // part + gripper pad + carriage, in the part's frame
+  sim::MovingBody arm;       // gripper pad + carriage, in the gripper's frame
+  Pose grip = Pose::Identity();  // the gripper's frame in the part's frame
+};
+
 class AssemblyScene {
  public:
   AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options = {}, ArmGeometry arm = {});
@@ -47,6 +54,11 @@ class AssemblyScene {
   // Where the gripper pad sits on the part for a push along `direction`: on the face behind
   // it, in the part's frame.
   Pose grip_offset(PartIndex part, const Vec3& direction) const;
+
+  // The part held for a push along `direction`: the pad on the face behind it, the carriage
+  // running away from the part.
+  HeldPart hold(PartIndex part, const Vec3& direction) const;
+  std::optional<Collision> collision_at(const sim::MovingBody& body, const Pose& pose, const std::string& phase) const;
 
   // Runs the trajectory in the collision world: the held part with the arm, then the arm
   // alone once it has let go. The first collision, or nothing.

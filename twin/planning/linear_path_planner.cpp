@@ -1,5 +1,3 @@
-#include <stdexcept>
-
 #include "twin/planning/path_planner.hpp"
 
 namespace twin {
@@ -42,6 +40,7 @@ Trajectory LinearPathPlanner::straight_insertion(const AssemblyScene& scene, Par
   const Pose grip = scene.grip_offset(part, direction);
   Trajectory t;
   t.direction = direction;
+  t.grip_direction = direction;
   t.label = label;
   auto add = [&](const char* phase, const Pose& part_pose, const Pose& gripper, bool holding) {
     t.waypoints.push_back({phase, part_pose, gripper, holding});
@@ -61,9 +60,5 @@ std::optional<Trajectory> LinearPathPlanner::next(const AssemblyScene& scene, Pa
   return straight_insertion(scene, part, label, direction);
 }
 
-std::unique_ptr<PathPlanner> make_path_planner(const std::string& name) {
-  if (name == "linear") return std::make_unique<LinearPathPlanner>();
-  throw std::invalid_argument("unknown path planner '" + name + "' (linear)");
-}
 
 }  // namespace twin

@@ -17,7 +17,8 @@ struct Waypoint {
 
 struct Trajectory {
   std::vector<Waypoint> waypoints;
-  Vec3 direction = Vec3::Zero();  // unit vector of the final insertion motion
+  Vec3 direction = Vec3::Zero();       // unit vector of the final insertion motion
+  Vec3 grip_direction = Vec3::Zero();  // the pad sits on the part's face behind this push
   std::string label;              // e.g. "down", "-x", "ompl"
 
   // Distance the part travels, m.
