@@ -10,4 +10,4 @@ mkdir -p out
 build/release/deploy/cellctl/cellctl describe deploy/products/cranfield/cranfield.aml
 build/release/deploy/cellctl/cellctl describe --json deploy/products/cranfield/cranfield.aml > out/cranfield-product.json
 echo
-build/release/deploy/cellctl/cellctl plan deploy/products/cranfield/cranfield.aml --json out/cranfield-plan.json
+build/release/deploy/cellctl/cellctl plan deploy/products/cranfield/cranfield.aml --json out/cranfield-plan.json --gltf out/cranfield.gltf

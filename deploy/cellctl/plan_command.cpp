@@ -5,6 +5,7 @@
 
 #include "deploy/cellctl/plan_report.hpp"
 #include "twin/geometry/product_loader.hpp"
+#include "twin/report/gltf_animation.hpp"
 
 namespace cellctl {
 
@@ -14,6 +15,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string sequence = "search";
     std::string path = "linear";
     std::string json;
+    std::string gltf;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("plan", "Plan and validate the assembly by virtual assembly");
@@ -21,6 +23,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--sequence", options->sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
   cmd->add_option("--path", options->path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   cmd->add_option("--json", options->json, "Write the plan as JSON to this file");
+  cmd->add_option("--gltf", options->gltf, "Write the virtual assembly as a glTF 2.0 animation (.gltf)");
   cmd->callback([options, &exit_code] {
     sim::MeshCache meshes;
     const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
@@ -39,6 +42,10 @@ void add_plan_command(CLI::App& app, int& exit_code) {
       out << plan_json(loaded.product, plan).dump(2) << '\n';
       if (!out) throw std::runtime_error("cannot write " + options->json);
       std::cout << "\nwrote " << options->json << '\n';
+    }
+    if (!options->gltf.empty()) {
+      twin::write_gltf_animation(loaded, plan, options->gltf);
+      std::cout << (options->json.empty() ? "\n" : "") << "wrote " << options->gltf << '\n';
     }
     exit_code = plan.complete ? 0 : 1;
   });
