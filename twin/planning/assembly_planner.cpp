@@ -30,7 +30,7 @@ class Search {
     plan_.sequence_planner = sequence_.name();
     plan_.path_planner = path_.name();
     plan_.complete = extend();
-    if (!plan_.complete) plan_.steps = deepest_;
+    if (!plan_.complete && deepest_.size() > plan_.steps.size()) plan_.steps = deepest_;
     report();
     return std::move(plan_);
   }
@@ -60,9 +60,9 @@ class Search {
       assembled_[part] = true;
       scene_.assemble(part);
       plan_.steps.push_back({part, std::move(*trajectory), std::move(tried)});
-      if (plan_.steps.size() > deepest_.size()) deepest_ = plan_.steps;
       if (extend()) return true;
       if (!sequence_.backtracks() || stopped_) return false;
+      if (plan_.steps.size() > deepest_.size()) deepest_ = plan_.steps;  // the best partial plan, for the report
       // Partial disassembly: take the part off and try another one in its place.
       plan_.steps.pop_back();
       scene_.disassemble(part);
@@ -126,7 +126,7 @@ class Search {
   void report_open_order() {
     AssemblyScene replay(product_, options_.collision, options_.arm);
     for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
-      const auto allowed = parts_the_links_allow(replay);
+      const auto& allowed = replay.frontier();
       if (allowed.size() > 1) {
         std::vector<std::string> names;
         for (PartIndex p : allowed) names.push_back(name(p));

@@ -1,7 +1,11 @@
 #include "twin/planning/assembly_scene.hpp"
 
+#include <algorithm>
+
 namespace twin {
 namespace {
+
+constexpr double kOnSurface = 1e-4;  // m: a part this close to y = 0 stands on the station
 
 // Index and sign of a direction's dominant axis.
 std::pair<int, double> dominant_axis(const Vec3& direction) {
@@ -30,6 +34,7 @@ AssemblyScene::AssemblyScene(const LoadedProduct& product, sim::CollisionOptions
     }
     bounds_.push_back(box);
   }
+  for (PartIndex i = 0; i < parts.size(); ++i) update_frontier(i);
   // The station's surface: a slab whose top is the assembly surface, y = 0.
   const sim::BodyId station = world_.add_static_box("station", Vec3(1.0, 0.025, 1.0), translation(Vec3(0, -0.025, 0)));
   names_[station] = "station";
@@ -41,6 +46,9 @@ void AssemblyScene::assemble(PartIndex part) {
   const sim::BodyId id = world_.add_static_mesh(p.name, product_.meshes[part], p.final_pose);
   bodies_[part] = id;
   names_[id] = p.name;
+  assembled_bounds_.extend(bounds_[part]);
+  update_frontier(part);
+  for (PartIndex neighbour : neighbours(part)) update_frontier(neighbour);
 }
 
 void AssemblyScene::disassemble(PartIndex part) {
@@ -49,12 +57,35 @@ void AssemblyScene::disassemble(PartIndex part) {
   world_.remove(it->second);
   names_.erase(it->second);
   bodies_.erase(it);
+  assembled_bounds_.setEmpty();
+  for (const auto& [p, _] : bodies_) assembled_bounds_.extend(bounds_[p]);
+  update_frontier(part);
+  for (PartIndex neighbour : neighbours(part)) update_frontier(neighbour);
 }
 
-Eigen::AlignedBox3d AssemblyScene::assembled_bounds() const {
-  Eigen::AlignedBox3d box;
-  for (const auto& [part, _] : bodies_) box.extend(bounds_[part]);
-  return box;
+std::vector<PartIndex> AssemblyScene::neighbours(PartIndex part) const {
+  std::vector<PartIndex> out;
+  const Product& product = product_.product;
+  for (std::size_t ci : product.connections_of(part)) {
+    const Connection& c = product.connections()[ci];
+    out.push_back(c.part1 == part ? c.part2 : c.part1);
+  }
+  return out;
+}
+
+bool AssemblyScene::stands_on_surface(PartIndex part) const { return bounds_[part].min().y() < kOnSurface; }
+
+bool AssemblyScene::linked_to_assembled(PartIndex part) const {
+  const auto n = neighbours(part);
+  return std::any_of(n.begin(), n.end(), [&](PartIndex q) { return is_assembled(q); });
+}
+
+void AssemblyScene::update_frontier(PartIndex part) {
+  if (!is_assembled(part) && (stands_on_surface(part) || linked_to_assembled(part))) {
+    frontier_.insert(part);
+  } else {
+    frontier_.erase(part);
+  }
 }
 
 Eigen::Vector3d AssemblyScene::pad_half_extents(PartIndex part, const Vec3& direction) const {

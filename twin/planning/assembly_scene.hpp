@@ -5,6 +5,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include "sim/collision/collision_world.hpp"
@@ -49,7 +50,11 @@ class AssemblyScene {
   // The part's bounding box in the finished product.
   const Eigen::AlignedBox3d& final_bounds(PartIndex part) const { return bounds_[part]; }
   // The assembled parts' bounding box (empty when nothing is assembled).
-  Eigen::AlignedBox3d assembled_bounds() const;
+  const Eigen::AlignedBox3d& assembled_bounds() const { return assembled_bounds_; }
+  // Unassembled parts the links allow next: standing on the station's surface (which holds
+  // them) or linked to an assembled part. Kept up to date as parts come and go.
+  const std::set<PartIndex>& frontier() const { return frontier_; }
+  bool stands_on_surface(PartIndex part) const;
 
   // Where the gripper pad sits on the part for a push along `direction`: on the face behind
   // it, in the part's frame.
@@ -73,7 +78,13 @@ class AssemblyScene {
   const LoadedProduct& product_;
   ArmGeometry arm_;
   sim::CollisionWorld world_;
+  std::vector<PartIndex> neighbours(PartIndex part) const;
+  bool linked_to_assembled(PartIndex part) const;
+  void update_frontier(PartIndex part);
+
   std::vector<Eigen::AlignedBox3d> bounds_;
+  Eigen::AlignedBox3d assembled_bounds_;
+  std::set<PartIndex> frontier_;
   std::map<PartIndex, sim::BodyId> bodies_;
   std::map<sim::BodyId, std::string> names_;
 };

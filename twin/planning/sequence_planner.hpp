@@ -42,11 +42,5 @@ class SearchSequencePlanner : public SequencePlanner {
 
 std::unique_ptr<SequencePlanner> make_sequence_planner(const std::string& name);
 
-// Rules the planners share.
-bool stands_on_surface(const AssemblyScene& scene, PartIndex part);
-bool linked_to_assembled(const AssemblyScene& scene, PartIndex part);
-// Unassembled parts the links allow next: linked to an assembled part, or standing on the
-// surface. No part floats: each is held by the surface or by a part it is linked to.
-std::vector<PartIndex> parts_the_links_allow(const AssemblyScene& scene);
 
 }  // namespace twin
