@@ -1,5 +1,6 @@
-// Planning speed: Cranfield and generated walls of 10, 100, 1000 blocks, for each sequence
-// planner; swept collision checks per second. Run by hand (Release):
+// Planning speed: Cranfield, the Lego tower, generated walls (10 blocks wide) and towers
+// (one block wide) of 10, 100, 1000 blocks, for each sequence planner; swept collision
+// checks per second. Run by hand (Release):
 //   build/release/tests/bench_planning
 // Figures and the command are recorded in docs/performance.md.
 
@@ -14,8 +15,8 @@
 namespace {
 
 std::filesystem::path wall_dir(int columns, int rows) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("bench-wall-" + std::to_string(::getpid()) + "-" + std::to_string(columns * rows));
+  const auto dir = std::filesystem::temp_directory_path() / ("bench-wall-" + std::to_string(::getpid()) + "-" +
+                                                             std::to_string(columns) + "x" + std::to_string(rows));
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "block.obj") << test::wall_block_obj();
   std::ofstream(dir / "wall.aml") << test::wall_aml(columns, rows, "block.obj");
@@ -51,6 +52,13 @@ void BM_Wall(benchmark::State& state, const std::string& sequence) {
   std::filesystem::remove_all(file.parent_path());
 }
 
+void BM_Tower(benchmark::State& state, const std::string& sequence) {
+  const int parts = static_cast<int>(state.range(0));
+  const auto file = wall_dir(1, parts);
+  plan_file(state, file, sequence);
+  std::filesystem::remove_all(file.parent_path());
+}
+
 // One swept check: a Cranfield peg down through its hole, 200 mm.
 void BM_PegSweep(benchmark::State& state) {
   sim::MeshCache cache;
@@ -77,6 +85,8 @@ BENCHMARK_CAPTURE(BM_LegoTower, paper, std::string("paper"))->Unit(benchmark::kM
 BENCHMARK_CAPTURE(BM_LegoTower, search, std::string("search"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Tower, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Tower, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PegSweep)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();
