@@ -1,0 +1,37 @@
+#pragma once
+// An IEC 61499 event and the data that travels WITH it.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <variant>
+
+namespace fb {
+
+using Value = std::variant<bool, std::int64_t, double, std::string>;
+using Data = std::map<std::string, Value>;
+
+struct Event {
+  std::string name;
+  Data data;
+};
+
+// data["x"] as T; throws std::invalid_argument naming the key when missing or of another type.
+template <class T>
+const T& get(const Data& data, const std::string& key);
+
+}  // namespace fb
+
+#include <stdexcept>
+
+namespace fb {
+
+template <class T>
+const T& get(const Data& data, const std::string& key) {
+  const auto it = data.find(key);
+  if (it == data.end()) throw std::invalid_argument("event data has no '" + key + "'");
+  if (const T* value = std::get_if<T>(&it->second)) return *value;
+  throw std::invalid_argument("event data '" + key + "' has another type");
+}
+
+}  // namespace fb

@@ -1,0 +1,134 @@
+#include <algorithm>
+
+#include "services/runtime/basic_block.hpp"
+#include "services/runtime/resource.hpp"
+
+namespace fb {
+
+// --- FunctionBlock --------------------------------------------------------------------------
+
+namespace {
+bool declared(const std::vector<EventPort>& ports, const std::string& name) {
+  return std::any_of(ports.begin(), ports.end(), [&](const EventPort& p) { return p.name == name; });
+}
+}  // namespace
+
+bool FunctionBlock::has_input(const std::string& event) const { return declared(inputs_, event); }
+bool FunctionBlock::has_output(const std::string& event) const { return declared(outputs_, event); }
+
+void FunctionBlock::declare_input(std::string name, std::vector<std::string> with) {
+  inputs_.push_back({std::move(name), std::move(with)});
+}
+
+void FunctionBlock::declare_output(std::string name, std::vector<std::string> with) {
+  outputs_.push_back({std::move(name), std::move(with)});
+}
+
+void FunctionBlock::emit(const std::string& output, Data data) {
+  if (!has_output(output)) throw std::logic_error(name_ + " has no event output " + output);
+  if (!resource_) throw std::logic_error(name_ + " emitted " + output + " before joining a resource");
+  resource_->emitted(*this, output, data);
+}
+
+// --- BasicBlock -----------------------------------------------------------------------------
+
+BasicBlock::BasicBlock(std::string name, std::string initial_state)
+    : FunctionBlock(std::move(name)), state_(std::move(initial_state)) {}
+
+void BasicBlock::transition(std::string from, std::string event, std::string to, Action action, Guard guard) {
+  transitions_.push_back({std::move(from), std::move(event), std::move(to), std::move(action), std::move(guard)});
+}
+
+void BasicBlock::receive(const Event& event) {
+  for (const auto& t : transitions_) {
+    if (t.from != state_ || t.event != event.name || (t.guard && !t.guard(event.data))) continue;
+    state_ = t.to;  // entered before the action, so that events the action emits see it
+    if (t.action) t.action(event.data);
+    return;
+  }
+  ++unhandled_;
+}
+
+// --- Resource -------------------------------------------------------------------------------
+
+Resource::Resource(std::string name, std::size_t queue_capacity) : name_(std::move(name)), capacity_(queue_capacity) {}
+
+void Resource::adopt(std::unique_ptr<FunctionBlock> block) {
+  if (blocks_.count(block->name())) throw std::logic_error(name_ + " has a block " + block->name() + " already");
+  block->resource_ = this;
+  blocks_.emplace(block->name(), std::move(block));
+}
+
+FunctionBlock& Resource::block(const std::string& name) const {
+  const auto it = blocks_.find(name);
+  if (it == blocks_.end()) throw std::logic_error(name_ + " has no block " + name);
+  return *it->second;
+}
+
+void Resource::connect(const std::string& from, const std::string& output, const std::string& to,
+                       const std::string& input) {
+  FunctionBlock& source = block(from);
+  FunctionBlock& target = block(to);
+  if (!source.has_output(output)) throw std::logic_error(from + " has no event output " + output);
+  if (!target.has_input(input)) throw std::logic_error(to + " has no event input " + input);
+  connections_.emplace(std::make_pair(&source, output), std::make_pair(&target, input));
+}
+
+void Resource::enqueue(FunctionBlock& target, Event event) {
+  if (queue_.size() >= capacity_) {
+    ++refused_;
+    throw EventQueueOverflow("event queue of resource " + name_ + " is full (" + std::to_string(capacity_) +
+                             " events): refused " + target.name() + "." + event.name);
+  }
+  queue_.push_back({&target, std::move(event)});
+}
+
+void Resource::post(const std::string& name, const std::string& input, Data data) {
+  FunctionBlock& target = block(name);
+  if (!target.has_input(input)) throw std::logic_error(name + " has no event input " + input);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    enqueue(target, {input, std::move(data)});
+  }
+  ready_.notify_one();
+}
+
+void Resource::emitted(FunctionBlock& from, const std::string& output, const Data& data) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto [begin, end] = connections_.equal_range({&from, output});
+  for (auto it = begin; it != end; ++it) enqueue(*it->second.first, {it->second.second, data});
+}
+
+bool Resource::run_one() {
+  Delivery next;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (queue_.empty()) return false;
+    next = std::move(queue_.front());
+    queue_.pop_front();
+  }
+  next.block->receive(next.event);
+  ++delivered_;
+  return true;
+}
+
+std::size_t Resource::run_until_idle() {
+  std::size_t count = 0;
+  while (run_one()) ++count;
+  return count;
+}
+
+bool Resource::wait_and_run_one(std::chrono::milliseconds timeout) {
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty(); })) return false;
+  }
+  return run_one();
+}
+
+std::size_t Resource::queued() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return queue_.size();
+}
+
+}  // namespace fb

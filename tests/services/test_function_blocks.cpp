@@ -1,0 +1,143 @@
+// The function-block runtime, driven with events and no DDS.
+
+#include <thread>
+
+#include <catch2/catch.hpp>
+
+#include "services/blocks/command_lifecycle.hpp"
+#include "services/runtime/block_test_fixture.hpp"
+
+namespace {
+
+// Counts REQ events and answers each with CNF carrying the running count.
+class Counter : public fb::BasicBlock {
+ public:
+  explicit Counter(std::string name) : BasicBlock(std::move(name), "READY") {
+    declare_input("REQ", {"step"});
+    declare_output("CNF", {"count"});
+    transition("READY", "REQ", "READY", [this](const fb::Data& d) {
+      count += d.count("step") ? fb::get<std::int64_t>(d, "step") : 1;
+      emit("CNF", {{"count", count}});
+    }, [](const fb::Data& d) { return !d.count("step") || fb::get<std::int64_t>(d, "step") > 0; });
+  }
+  std::int64_t count = 0;
+};
+
+using Names = std::vector<std::string>;
+template <class B>
+Names names(const std::vector<fb::Event>& events) {
+  return fb::BlockTestFixture<B>::names(events);
+}
+
+}  // namespace
+
+TEST_CASE("a resource delivers events along its connections, one at a time, in order", "[fb]") {
+  fb::Resource resource("r", 16);
+  auto& a = resource.add(std::make_unique<Counter>("a"));
+  auto& b = resource.add(std::make_unique<Counter>("b"));
+  auto& c = resource.add(std::make_unique<Counter>("c"));
+  resource.connect("a", "CNF", "b", "REQ");
+  resource.connect("a", "CNF", "c", "REQ");  // one output, two inputs
+  resource.post("a", "REQ");
+  resource.post("a", "REQ");
+  CHECK(resource.run_until_idle() == 6);
+  CHECK(a.count == 2);
+  CHECK(b.count == 2);
+  CHECK(c.count == 2);
+}
+
+TEST_CASE("a full event queue refuses loudly and counts what it refused", "[fb]") {
+  fb::Resource resource("station", 2);
+  auto& a = resource.add(std::make_unique<Counter>("a"));
+  resource.post("a", "REQ");
+  resource.post("a", "REQ");
+  CHECK_THROWS_MATCHES(resource.post("a", "REQ"), fb::EventQueueOverflow,
+                       Catch::Matchers::Message("event queue of resource station is full (2 events): refused a.REQ"));
+  CHECK(resource.refused() == 1);
+  CHECK(resource.run_until_idle() == 2);
+  CHECK(a.count == 2);
+  // Events a block emits into a full queue are refused the same way.
+  fb::Resource tight("tight", 1);
+  tight.add(std::make_unique<Counter>("x"));
+  tight.add(std::make_unique<Counter>("y"));
+  tight.add(std::make_unique<Counter>("z"));
+  tight.connect("x", "CNF", "y", "REQ");
+  tight.connect("x", "CNF", "z", "REQ");
+  tight.post("x", "REQ");
+  CHECK_THROWS_AS(tight.run_one(), fb::EventQueueOverflow);
+  CHECK(tight.refused() == 1);
+}
+
+TEST_CASE("wiring mistakes are errors at once", "[fb]") {
+  fb::Resource resource("r", 4);
+  resource.add(std::make_unique<Counter>("a"));
+  CHECK_THROWS_AS(resource.connect("a", "NOPE", "a", "REQ"), std::logic_error);
+  CHECK_THROWS_AS(resource.connect("a", "CNF", "a", "NOPE"), std::logic_error);
+  CHECK_THROWS_AS(resource.connect("a", "CNF", "ghost", "REQ"), std::logic_error);
+  CHECK_THROWS_AS(resource.post("a", "CNF"), std::logic_error);
+  CHECK_THROWS_AS(resource.add(std::make_unique<Counter>("a")), std::logic_error);
+}
+
+TEST_CASE("an ECC fires the first transition whose event and guard match", "[fb]") {
+  fb::BlockTestFixture<Counter> fixture("counter");
+  CHECK(names<Counter>(fixture.send("REQ", {{"step", std::int64_t{5}}})) == Names{"CNF"});
+  CHECK(fixture.block().count == 5);
+  CHECK(fixture.send("REQ", {{"step", std::int64_t{-1}}}).empty());  // guard false: consumed
+  CHECK(fixture.block().unhandled_events() == 1);
+  const auto out = fixture.send("REQ");
+  REQUIRE(out.size() == 1);
+  CHECK(fb::get<std::int64_t>(out[0].data, "count") == 6);
+}
+
+TEST_CASE("command life cycle: accepted, executing, succeeded", "[fb][lifecycle]") {
+  fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
+  const auto accepted = f.send("COMMAND", {{"command_id", std::string("c1")}});
+  CHECK(names<fb::CommandLifecycle>(accepted) == Names{"ACCEPTED", "START"});
+  CHECK(fb::get<std::string>(accepted[0].data, "command_id") == "c1");
+  const auto progress = f.send("PROGRESS", {{"progress", 0.5}});
+  REQUIRE(names<fb::CommandLifecycle>(progress) == Names{"EXECUTING"});
+  CHECK(fb::get<double>(progress[0].data, "progress") == 0.5);
+  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED"});
+  CHECK(f.block().state() == "IDLE");
+}
+
+TEST_CASE("command life cycle: one command at a time; failures carry their reason", "[fb][lifecycle]") {
+  fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
+  f.send("COMMAND", {{"command_id", std::string("c1")}});
+  const auto busy = f.send("COMMAND", {{"command_id", std::string("c2")}});
+  REQUIRE(names<fb::CommandLifecycle>(busy) == Names{"REJECTED"});
+  CHECK(fb::get<std::string>(busy[0].data, "command_id") == "c2");
+  CHECK(fb::get<std::string>(busy[0].data, "reason") == "busy with c1");
+  const auto aborted = f.send("FAIL", {{"reason", std::string("collision with B6")}});
+  REQUIRE(names<fb::CommandLifecycle>(aborted) == Names{"ABORTED"});
+  CHECK(fb::get<std::string>(aborted[0].data, "reason") == "collision with B6");
+  CHECK(names<fb::CommandLifecycle>(f.send("COMMAND", {{"command_id", std::string("c2")}})) ==
+        Names{"ACCEPTED", "START"});
+}
+
+TEST_CASE("command life cycle: cancel, and a device that finishes before it can stop", "[fb][lifecycle]") {
+  fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
+  f.send("COMMAND", {{"command_id", std::string("c1")}});
+  CHECK(f.send("CANCEL", {{"command_id", std::string("other")}}).empty());  // not ours: ignored
+  CHECK(names<fb::CommandLifecycle>(f.send("CANCEL", {{"command_id", std::string("c1")}})) ==
+        Names{"CANCELING", "STOP"});
+  CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED"});
+
+  f.send("COMMAND", {{"command_id", std::string("c2")}});
+  f.send("CANCEL", {{"command_id", std::string("c2")}});
+  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED"});
+  CHECK(f.block().state() == "IDLE");
+}
+
+TEST_CASE("events posted from another thread arrive in order", "[fb][threads]") {
+  fb::Resource resource("r", 2048);
+  auto& a = resource.add(std::make_unique<Counter>("a"));
+  std::thread producer([&] {
+    for (std::int64_t i = 1; i <= 1000; ++i) resource.post("a", "REQ", {{"step", i}});
+  });
+  std::size_t delivered = 0;
+  while (delivered < 1000 && resource.wait_and_run_one(std::chrono::seconds(5))) ++delivered;
+  producer.join();
+  CHECK(delivered == 1000);
+  CHECK(a.count == 1000 * 1001 / 2);
+}
