@@ -39,6 +39,9 @@ class FunctionBlock {
   // Sends an event from one of this block's outputs; the resource queues it for every
   // input connected to that output. Throws std::logic_error for an undeclared output.
   void emit(const std::string& output, Data data = {});
+  // Queues an event for one of this block's own inputs, from any thread (a DDS listener);
+  // throws EventQueueOverflow when the resource's queue is full.
+  void post_to_self(const std::string& input, Data data = {});
 
  private:
   friend class Resource;

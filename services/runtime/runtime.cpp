@@ -30,6 +30,11 @@ void FunctionBlock::emit(const std::string& output, Data data) {
   resource_->emitted(*this, output, data);
 }
 
+void FunctionBlock::post_to_self(const std::string& input, Data data) {
+  if (!resource_) throw std::logic_error(name_ + " posted " + input + " before joining a resource");
+  resource_->post(name_, input, std::move(data));
+}
+
 // --- BasicBlock -----------------------------------------------------------------------------
 
 BasicBlock::BasicBlock(std::string name, std::string initial_state)

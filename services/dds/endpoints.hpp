@@ -1,0 +1,152 @@
+#pragma once
+// Typed DDS writers and readers on a participant, with the QoS of their topic kind.
+// T is a fastddsgen type, PubSubType its generated TypeSupport class.
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/core/LoanableSequence.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "services/dds/participant.hpp"
+#include "services/dds/qos.hpp"
+
+namespace dds {
+
+namespace fdds = eprosima::fastdds::dds;
+
+// The topic of that name on the participant, created (and its type registered) if needed.
+template <class PubSubType>
+fdds::Topic* topic_on(fdds::DomainParticipant& participant, const std::string& name) {
+  fdds::TypeSupport type(new PubSubType());
+  type.register_type(&participant);
+  if (auto* existing = participant.find_topic(name, eprosima::fastrtps::Duration_t(0, 0))) return existing;
+  fdds::Topic* topic = participant.create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+  if (!topic) throw std::runtime_error("cannot create topic " + name);
+  return topic;
+}
+
+template <class T, class PubSubType>
+class Writer : private fdds::DataWriterListener {
+ public:
+  Writer(ParticipantPtr participant, const std::string& topic, TopicKind kind, const QosSettings& settings = {})
+      : participant_(std::move(participant)) {
+    publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    writer_ = publisher_->create_datawriter(topic_on<PubSubType>(*participant_, topic), writer_qos(kind, settings), this);
+    if (!writer_) throw std::runtime_error("cannot create a writer on " + topic);
+  }
+  ~Writer() override {
+    publisher_->delete_datawriter(writer_);
+    participant_->delete_publisher(publisher_);
+  }
+  Writer(const Writer&) = delete;
+  Writer& operator=(const Writer&) = delete;
+
+  bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
+
+  // Waits until at least `readers` readers have matched; never sleep a guessed time.
+  bool wait_for_readers(int readers, std::chrono::milliseconds timeout) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return matched_changed_.wait_for(lock, timeout, [&] { return matched_ >= readers; });
+  }
+
+ private:
+  void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      matched_ = status.current_count;
+    }
+    matched_changed_.notify_all();
+  }
+
+  ParticipantPtr participant_;
+  fdds::Publisher* publisher_ = nullptr;
+  fdds::DataWriter* writer_ = nullptr;
+  std::mutex mutex_;
+  std::condition_variable matched_changed_;
+  int matched_ = 0;
+};
+
+template <class T, class PubSubType>
+class Reader : private fdds::DataReaderListener {
+ public:
+  // Called on Fast DDS's listener thread: `on_sample` for each new sample; on state topics,
+  // `on_gone` with an instance's last sample when its writers are gone (liveliness lost,
+  // process ended) or it was disposed.
+  Reader(ParticipantPtr participant, const std::string& topic, TopicKind kind, std::function<void(const T&)> on_sample,
+         std::function<void(const T&)> on_gone = {}, const QosSettings& settings = {})
+      : participant_(std::move(participant)), kind_(kind), on_sample_(std::move(on_sample)), on_gone_(std::move(on_gone)) {
+    subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
+    if (!reader_) throw std::runtime_error("cannot create a reader on " + topic);
+  }
+  ~Reader() override {
+    reader_->set_listener(nullptr);
+    subscriber_->delete_datareader(reader_);
+    participant_->delete_subscriber(subscriber_);
+  }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+ private:
+  void on_data_available(fdds::DataReader* reader) override { drain(reader); }
+  // A writer that leaves or dies changes its instances' state; Fast DDS 2.9 does not always
+  // announce that through on_data_available, so look then too.
+  void on_subscription_matched(fdds::DataReader* reader, const fdds::SubscriptionMatchedStatus& status) override {
+    if (status.current_count_change < 0) drain(reader);
+  }
+  void on_liveliness_changed(fdds::DataReader* reader, const fdds::LivelinessChangedStatus& status) override {
+    if (status.not_alive_count_change > 0) drain(reader);
+  }
+
+  // Event topics: take every new sample. State topics: read new samples but keep the last
+  // one per instance, so that when an instance's writers are gone (its state turns
+  // NOT_ALIVE) the kept sample tells which instance it was; then take it.
+  void drain(fdds::DataReader* reader) {
+    std::lock_guard<std::mutex> lock(drain_mutex_);
+    fdds::LoanableSequence<T> samples;
+    fdds::SampleInfoSeq infos;
+    const auto visit = [&](auto&& each) {
+      for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
+        if (infos[i].valid_data) each(samples[i]);
+      }
+      reader->return_loan(samples, infos);
+    };
+    const auto ok = ReturnCode_t::RETCODE_OK;
+    if (kind_ == TopicKind::events) {
+      if (reader->take(samples, infos) == ok) visit([&](const T& s) { if (on_sample_) on_sample_(s); });
+      return;
+    }
+    if (reader->read(samples, infos, fdds::LENGTH_UNLIMITED, fdds::NOT_READ_SAMPLE_STATE, fdds::ANY_VIEW_STATE,
+                     fdds::ALIVE_INSTANCE_STATE) == ok) {
+      visit([&](const T& s) { if (on_sample_) on_sample_(s); });
+    }
+    if (reader->take(samples, infos, fdds::LENGTH_UNLIMITED, fdds::ANY_SAMPLE_STATE, fdds::ANY_VIEW_STATE,
+                     fdds::NOT_ALIVE_INSTANCE_STATE) == ok) {
+      visit([&](const T& s) { if (on_gone_) on_gone_(s); });
+    }
+  }
+
+  ParticipantPtr participant_;
+  TopicKind kind_;
+  std::function<void(const T&)> on_sample_;
+  std::function<void(const T&)> on_gone_;
+  std::mutex drain_mutex_;
+  fdds::Subscriber* subscriber_ = nullptr;
+  fdds::DataReader* reader_ = nullptr;
+};
+
+}  // namespace dds

@@ -1,0 +1,40 @@
+#include "services/dds/participant.hpp"
+
+#include <stdexcept>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+namespace dds {
+
+ParticipantPtr make_participant(const std::string& name, const ParticipantSettings& settings) {
+  using namespace eprosima::fastdds::dds;
+  DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
+  qos.name(name);
+  if (settings.localhost_only) {
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList.emplace_back("127.0.0.1");
+    qos.transport().user_transports.push_back(udp);
+    eprosima::fastrtps::rtps::Locator_t peer;
+    peer.kind = LOCATOR_KIND_UDPv4;
+    eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, "127.0.0.1");
+    qos.wire_protocol().builtin.initialPeersList.push_back(peer);
+  }
+  DomainParticipantFactory* factory = DomainParticipantFactory::get_instance();
+  DomainParticipant* participant = factory->create_participant(settings.domain_id, qos);
+  if (!participant) {
+    throw std::runtime_error("cannot create DDS participant '" + name + "' on domain " +
+                             std::to_string(settings.domain_id));
+  }
+  return ParticipantPtr(participant, [](DomainParticipant* p) {
+    p->delete_contained_entities();
+    DomainParticipantFactory::get_instance()->delete_participant(p);
+  });
+}
+
+}  // namespace dds

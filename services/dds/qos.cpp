@@ -1,0 +1,38 @@
+#include "services/dds/qos.hpp"
+
+namespace dds {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+
+template <class Qos>
+void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
+  qos.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  if (kind == TopicKind::state) {
+    qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+    qos.history().kind = KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = 1;
+    qos.liveliness().kind = AUTOMATIC_LIVELINESS_QOS;
+    qos.liveliness().lease_duration = eprosima::fastrtps::Duration_t(settings.liveliness_lease_s);
+    qos.liveliness().announcement_period = eprosima::fastrtps::Duration_t(settings.liveliness_lease_s / 3);
+  } else {
+    qos.durability().kind = VOLATILE_DURABILITY_QOS;
+    qos.history().kind = KEEP_ALL_HISTORY_QOS;
+  }
+}
+
+}  // namespace
+
+DataWriterQos writer_qos(TopicKind kind, const QosSettings& settings) {
+  DataWriterQos qos = DATAWRITER_QOS_DEFAULT;
+  apply(qos, kind, settings);
+  return qos;
+}
+
+DataReaderQos reader_qos(TopicKind kind, const QosSettings& settings) {
+  DataReaderQos qos = DATAREADER_QOS_DEFAULT;
+  apply(qos, kind, settings);
+  return qos;
+}
+
+}  // namespace dds

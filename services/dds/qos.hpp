@@ -1,0 +1,23 @@
+#pragma once
+// Every topic's QoS, in one place. Two kinds of topic carry the cell's traffic:
+//  - state (capabilities, order status, the clock): keyed, reliable, transient-local, the
+//    last sample per instance, writer liveliness with a lease, so late joiners see the
+//    current state and a dead writer's instances go NOT_ALIVE_NO_WRITERS;
+//  - events (commands, command events, negotiation messages): reliable, volatile, every
+//    sample kept until taken.
+
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+namespace dds {
+
+enum class TopicKind { state, events };
+
+struct QosSettings {
+  double liveliness_lease_s = 2.0;  // a state writer silent this long is taken for dead
+};
+
+eprosima::fastdds::dds::DataWriterQos writer_qos(TopicKind kind, const QosSettings& settings = {});
+eprosima::fastdds::dds::DataReaderQos reader_qos(TopicKind kind, const QosSettings& settings = {});
+
+}  // namespace dds

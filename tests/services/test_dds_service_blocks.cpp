@@ -1,0 +1,102 @@
+// Publish/subscribe service blocks over Fast DDS, two participants in one process. Each test
+// case has a domain id of its own, participants are localhost-only, and every wait is
+// bounded.
+
+#include <catch2/catch.hpp>
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "services/dds/service_blocks.hpp"
+#include "services/runtime/block_test_fixture.hpp"
+
+namespace {
+
+using EventPublisher = dds::PublishBlock<cell::CommandEvent, cell::CommandEventPubSubType>;
+using EventSubscriber = dds::SubscribeBlock<cell::CommandEvent, cell::CommandEventPubSubType>;
+using CapabilityWriter = dds::Writer<cell::Capability, cell::CapabilityPubSubType>;
+using CapabilitySubscriber = dds::SubscribeBlock<cell::Capability, cell::CapabilityPubSubType>;
+
+cell::CommandEvent to_event(const fb::Data& d) {
+  cell::CommandEvent e;
+  e.command_id(fb::get<std::string>(d, "command_id"));
+  e.resource_id("station");
+  e.state(cell::SUCCEEDED);
+  e.sim_time(fb::get<double>(d, "t"));
+  return e;
+}
+
+fb::Data from_event(const cell::CommandEvent& e) {
+  return {{"command_id", e.command_id()}, {"done", e.state() == cell::SUCCEEDED}, {"t", e.sim_time()}};
+}
+
+// Runs the resource until the recorder holds `count` events or 10 s pass.
+bool run_until(fb::Resource& resource, const fb::EventRecorder& recorder, std::size_t count) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (recorder.events.size() < count && std::chrono::steady_clock::now() < deadline) {
+    resource.wait_and_run_one(std::chrono::milliseconds(100));
+  }
+  return recorder.events.size() >= count;
+}
+
+}  // namespace
+
+TEST_CASE("an event published by one block arrives at a subscribing block", "[dds]") {
+  const dds::ParticipantSettings settings{171, true};
+  auto twin = dds::make_participant("test-twin", settings);
+  auto station = dds::make_participant("test-station", settings);
+
+  fb::Resource resource("r", 64);
+  auto& pub = resource.add(std::make_unique<EventPublisher>("pub", station, "cell/command_events",
+                                                            dds::TopicKind::events, to_event));
+  auto& sub = resource.add(std::make_unique<EventSubscriber>("sub", twin, "cell/command_events",
+                                                             dds::TopicKind::events, from_event));
+  auto& recorder = resource.add(std::make_unique<fb::EventRecorder>(sub));
+  resource.connect("sub", "IND", "recorder", "IND");
+  sub.start();
+  REQUIRE(pub.writer().wait_for_readers(1, std::chrono::seconds(10)));
+
+  resource.post("pub", "REQ", {{"command_id", std::string("c-1")}, {"t", 12.5}});
+  REQUIRE(run_until(resource, recorder, 1));
+  const fb::Data& got = recorder.events[0].data;
+  CHECK(fb::get<std::string>(got, "command_id") == "c-1");
+  CHECK(fb::get<bool>(got, "done"));
+  CHECK(fb::get<double>(got, "t") == 12.5);
+}
+
+TEST_CASE("state topics: a late reader sees the last state; a dead writer is noticed", "[dds]") {
+  const dds::ParticipantSettings settings{172, true};
+  auto twin = dds::make_participant("test-twin", settings);
+  auto buffer = dds::make_participant("test-buffer", settings);
+  dds::QosSettings quick;
+  quick.liveliness_lease_s = 0.5;
+  auto writer = std::make_unique<CapabilityWriter>(buffer, "cell/capabilities", dds::TopicKind::state, quick);
+  cell::Capability capability;
+  capability.resource_id("buffer-1");
+  capability.kind("buffer");
+  capability.stock().push_back(cell::PartStock());
+  capability.stock()[0].part_type("SquarePeg");
+  capability.stock()[0].count(2);
+  REQUIRE(writer->write(capability));  // before any reader exists
+
+  fb::Resource resource("r", 64);
+  auto& sub = resource.add(std::make_unique<CapabilitySubscriber>(
+      "capabilities", twin, "cell/capabilities", dds::TopicKind::state, [](const cell::Capability& c) {
+        return fb::Data{{"resource_id", c.resource_id()},
+                        {"stock", c.stock().empty() ? std::int64_t{0} : std::int64_t{c.stock()[0].count()}}};
+      }));
+  auto& recorder = resource.add(std::make_unique<fb::EventRecorder>(sub));
+  resource.connect("capabilities", "IND", "recorder", "IND");
+  resource.connect("capabilities", "GONE", "recorder", "GONE");
+  sub.start();
+  REQUIRE(run_until(resource, recorder, 1));
+  CHECK(recorder.events[0].name == "IND");
+  CHECK(fb::get<std::string>(recorder.events[0].data, "resource_id") == "buffer-1");
+  CHECK(fb::get<std::int64_t>(recorder.events[0].data, "stock") == 2);
+
+  // The buffer process dies: its participant goes away, its capability with it.
+  writer.reset();
+  buffer.reset();
+  REQUIRE(run_until(resource, recorder, 2));
+  CHECK(recorder.events[1].name == "GONE");
+  CHECK(fb::get<std::string>(recorder.events[1].data, "resource_id") == "buffer-1");
+}
