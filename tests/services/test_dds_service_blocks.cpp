@@ -63,7 +63,7 @@ TEST_CASE("an event published by one block arrives at a subscribing block", "[dd
   CHECK(fb::get<double>(got, "t") == 12.5);
 }
 
-TEST_CASE("state topics: a late reader sees the last state; a dead writer is noticed", "[dds]") {
+TEST_CASE("state topics: a late reader sees the last state, and a dead writer is noticed", "[dds]") {
   const dds::ParticipantSettings settings{172, true};
   auto twin = dds::make_participant("test-twin", settings);
   auto buffer = dds::make_participant("test-buffer", settings);

@@ -101,7 +101,7 @@ TEST_CASE("command life cycle: accepted, executing, succeeded", "[fb][lifecycle]
   CHECK(f.block().state() == "IDLE");
 }
 
-TEST_CASE("command life cycle: one command at a time; failures carry their reason", "[fb][lifecycle]") {
+TEST_CASE("command life cycle: one command at a time, and failures carry their reason", "[fb][lifecycle]") {
   fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
   f.send("COMMAND", {{"command_id", std::string("c1")}});
   const auto busy = f.send("COMMAND", {{"command_id", std::string("c2")}});

@@ -20,7 +20,7 @@ sim::MovingBody box_body(const Eigen::Vector3d& half, const sim::CollisionWorld&
 
 }  // namespace
 
-TEST_CASE("touching is not colliding; penetration beyond the tolerance is", "[collision]") {
+TEST_CASE("touching is not colliding, penetration beyond the tolerance is", "[collision]") {
   sim::CollisionWorld world;
   world.add_static_box("floor", {0.1, 0.01, 0.1}, at(0, -0.01, 0));
   const auto cube = box_body({0.01, 0.01, 0.01}, world);
@@ -57,7 +57,7 @@ TEST_CASE("a turning body is checked along its rotation", "[collision]") {
   CHECK(world.sweep(bar, start, turned));  // sweeps through the post at 45 degrees
 }
 
-TEST_CASE("Cranfield: a peg passes down through its hole; 1 mm to the side it collides", "[collision][cranfield]") {
+TEST_CASE("Cranfield: a peg passes down through its hole, and 1 mm to the side it collides", "[collision][cranfield]") {
   sim::MeshCache meshes;
   sim::CollisionWorld world;
   world.add_static_mesh("back", meshes.get(products("cranfield/meshes/faceplate.obj")), at(0, 0, 0));

@@ -64,7 +64,7 @@ TEST_CASE("Cranfield: back first, shaft before pendulum, square pegs before sepa
   }
 }
 
-TEST_CASE("Lego tower: bottom-up; the hanging brick goes in sideways after a collision", "[planning][lego]") {
+TEST_CASE("Lego tower: bottom-up, and the hanging brick goes in sideways after a collision", "[planning][lego]") {
   for (const char* sequence : {"paper", "search"}) {
     SECTION(sequence) {
       sim::MeshCache cache;
