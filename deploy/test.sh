@@ -8,9 +8,12 @@ bash deploy/install-deps.sh
 jobs=$(nproc)
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build/release -j "$jobs"
+# Shared-memory segments of DDS processes that died hard break discovery: clean them first.
+fastdds shm clean >/dev/null 2>&1 || true
 ctest --test-dir build/release --output-on-failure -j "$jobs"
 
 cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_SANITIZE=ON -DCELL_BUILD_BENCHMARKS=OFF
 cmake --build build/sanitize -j "$jobs"
+fastdds shm clean >/dev/null 2>&1 || true
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs"

@@ -1,0 +1,49 @@
+// buffer: one part buffer of the cell. Holds counts of part types, gives one part per
+// "give" command, publishes its capability (with its stock) until it is stopped.
+//   buffer --id buffer-1 --domain 42 --stock SquarePeg=2 --stock RoundPeg=4
+
+#include <csignal>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "services/buffer/buffer_service.hpp"
+
+namespace {
+volatile std::sig_atomic_t running = 1;
+void stop(int) { running = 0; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"buffer: a part buffer of the assembly cell"};
+  services::BufferConfig config;
+  std::vector<std::string> stock;
+  app.add_option("--id", config.id, "Resource id")->required();
+  app.add_option("--domain", config.dds.domain_id, "DDS domain id")->required();
+  app.add_option("--stock", stock, "TYPE=COUNT, repeatable");
+  app.add_option("--lease", config.liveliness_lease_s, "Liveliness lease of the capability, s");
+  try {
+    app.parse(argc, argv);
+    for (const auto& s : stock) {
+      const auto eq = s.find('=');
+      if (eq == std::string::npos) throw CLI::ValidationError("--stock", "expected TYPE=COUNT, got " + s);
+      config.stock[s.substr(0, eq)] = std::stoi(s.substr(eq + 1));
+    }
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: --stock: " << e.what() << '\n';
+    return 2;
+  }
+  std::signal(SIGINT, stop);
+  std::signal(SIGTERM, stop);
+  try {
+    services::BufferService service(config);
+    std::cout << "buffer " << config.id << " ready on domain " << config.dds.domain_id << std::endl;
+    service.run(running);
+  } catch (const std::exception& e) {
+    std::cerr << "error: buffer " << config.id << ": " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,100 @@
+// The buffer process on a DDS domain of its own: capability with stock, "give" commands
+// answered with command events, an empty buffer refusing, and its capability gone when it
+// stops. Bounded waits only; the process is always ended.
+
+#include <condition_variable>
+#include <mutex>
+
+#include <catch2/catch.hpp>
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "services/dds/endpoints.hpp"
+#include "tests/support/child_process.hpp"
+
+namespace {
+
+constexpr int kDomain = 181;
+
+// What the test's readers saw, guarded for the listener threads.
+struct Seen {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::vector<cell::Capability> capabilities;
+  std::vector<std::string> gone;
+  std::vector<cell::CommandEvent> events;
+
+  template <class Pred>
+  bool wait(Pred pred) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return changed.wait_for(lock, std::chrono::seconds(10), pred);
+  }
+  template <class F>
+  void add(F f) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      f();
+    }
+    changed.notify_all();
+  }
+};
+
+int stock_of(const cell::Capability& c, const std::string& type) {
+  for (const auto& s : c.stock()) {
+    if (s.part_type() == type) return s.count();
+  }
+  return -1;
+}
+
+cell::Command give(const std::string& id, const std::string& part) {
+  cell::Command c;
+  c.command_id(id);
+  c.resource_id("buffer-1");
+  c.operation("give");
+  c.part(part);
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stopped", "[process][buffer]") {
+  test::clean_stale_dds_segments();
+  test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-1", "--domain", std::to_string(kDomain), "--stock",
+                             "SquarePeg=1", "--lease", "0.5"});
+  Seen seen;
+  dds::QosSettings qos;
+  qos.liveliness_lease_s = 0.5;
+  auto participant = dds::make_participant("test-twin", {kDomain, true});
+  dds::Reader<cell::Capability, cell::CapabilityPubSubType> capabilities(
+      participant, "cell/capabilities", dds::TopicKind::state,
+      [&](const cell::Capability& c) { seen.add([&] { seen.capabilities.push_back(c); }); },
+      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id()); }); }, qos);
+  dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
+      participant, "cell/command_events", dds::TopicKind::events,
+      [&](const cell::CommandEvent& e) { seen.add([&] { seen.events.push_back(e); }); });
+  dds::Writer<cell::Command, cell::CommandPubSubType> commands(participant, "cell/commands", dds::TopicKind::events);
+
+  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+  CHECK(seen.capabilities.back().resource_id() == "buffer-1");
+  CHECK(seen.capabilities.back().kind() == "buffer");
+  CHECK(stock_of(seen.capabilities.back(), "SquarePeg") == 1);
+  REQUIRE(commands.wait_for_readers(1, std::chrono::seconds(10)));
+
+  REQUIRE(commands.write(give("c1", "SquarePeg")));
+  REQUIRE(seen.wait([&] { return seen.events.size() >= 2; }));
+  CHECK(seen.events[0].command_id() == "c1");
+  CHECK(seen.events[0].state() == cell::ACCEPTED);
+  CHECK(seen.events[1].state() == cell::SUCCEEDED);
+  REQUIRE(seen.wait([&] { return stock_of(seen.capabilities.back(), "SquarePeg") == 0; }));
+
+  REQUIRE(commands.write(give("c2", "SquarePeg")));
+  REQUIRE(seen.wait([&] { return seen.events.size() >= 4; }));
+  CHECK(seen.events[2].state() == cell::ACCEPTED);
+  CHECK(seen.events[3].command_id() == "c2");
+  CHECK(seen.events[3].state() == cell::ABORTED);
+  CHECK(seen.events[3].reason() == "buffer buffer-1 has no SquarePeg");
+
+  CHECK(buffer.stop() == 0);
+  REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));
+  CHECK(seen.gone.front() == "buffer-1");
+}

@@ -1,0 +1,71 @@
+#pragma once
+// A process a test starts, and always ends: stop() sends SIGTERM and reaps it; the
+// destructor kills (SIGKILL) and reaps whatever is still running.
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace test {
+
+// Removes the shared-memory segments of Fast DDS processes that died without cleaning up
+// (killed hard); stale segments break discovery of new processes. Segments of live
+// processes are left alone, so tests running in parallel are safe.
+inline void clean_stale_dds_segments() {
+  if (std::system("fastdds shm clean >/dev/null 2>&1") != 0) {
+    // Without the tool nothing is cleaned; the test still runs and says so if it fails.
+  }
+}
+
+class ChildProcess {
+ public:
+  explicit ChildProcess(std::vector<std::string> argv) {
+    std::vector<char*> args;
+    for (auto& a : argv) args.push_back(a.data());
+    args.push_back(nullptr);
+    if (posix_spawn(&pid_, args[0], nullptr, nullptr, args.data(), environ) != 0) {
+      throw std::runtime_error("cannot start " + argv[0]);
+    }
+  }
+  ~ChildProcess() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  pid_t pid() const { return pid_; }
+
+  // SIGTERM, then waits up to `timeout` for it to exit; its exit code, or -1 if it had to
+  // be killed.
+  int stop(std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+    ::kill(pid_, SIGTERM);
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    int status = 0;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return -1;  // the destructor kills it
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+}  // namespace test
