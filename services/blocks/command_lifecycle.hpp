@@ -20,7 +20,6 @@ namespace fb {
 class CommandLifecycle : public BasicBlock {
  public:
   explicit CommandLifecycle(std::string name);
-  const std::string& current_command() const { return command_; }
 
  private:
   void reject(const Data& data);

@@ -51,10 +51,7 @@ class Resource {
   // Waits up to `timeout` for an event and delivers it; false on time-out.
   bool wait_and_run_one(std::chrono::milliseconds timeout);
 
-  std::size_t queued() const;
-  std::size_t capacity() const { return capacity_; }
   std::size_t refused() const { return refused_; }
-  std::size_t delivered() const { return delivered_; }
 
  private:
   friend class FunctionBlock;
@@ -74,7 +71,6 @@ class Resource {
   std::condition_variable ready_;
   std::deque<Delivery> queue_;
   std::atomic<std::size_t> refused_{0};
-  std::atomic<std::size_t> delivered_{0};
 };
 
 }  // namespace fb

@@ -113,7 +113,6 @@ bool Resource::run_one() {
     queue_.pop_front();
   }
   next.block->receive(next.event);
-  ++delivered_;
   return true;
 }
 
@@ -129,11 +128,6 @@ bool Resource::wait_and_run_one(std::chrono::milliseconds timeout) {
     if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty(); })) return false;
   }
   return run_one();
-}
-
-std::size_t Resource::queued() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return queue_.size();
 }
 
 }  // namespace fb

@@ -193,8 +193,6 @@ void CollisionWorld::remove(BodyId body) {
   impl_->bodies.erase(it);
 }
 
-std::size_t CollisionWorld::body_count() const { return impl_->bodies.size(); }
-
 std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const Pose& pose) const {
   ++checks_;
   btCollisionObject& object = body.impl_->object;

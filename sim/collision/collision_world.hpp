@@ -71,7 +71,6 @@ class CollisionWorld {
   BodyId add_static_mesh(const std::string& name, std::shared_ptr<const TriangleMesh> mesh, const Pose& pose);
   BodyId add_static_box(const std::string& name, const Eigen::Vector3d& half_extents, const Pose& pose);
   void remove(BodyId body);
-  std::size_t body_count() const;
 
   // The deepest penetration of the body at a pose, if deeper than the tolerance.
   std::optional<Contact> penetration(const MovingBody& body, const Pose& pose) const;
