@@ -98,3 +98,28 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));
   CHECK(seen.gone.front() == "buffer-1");
 }
+
+TEST_CASE("buffer process killed hard: its capability goes when the liveliness lease runs out", "[process][buffer]") {
+  constexpr int domain = 182;
+  test::clean_stale_dds_segments();
+  test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-2", "--domain", std::to_string(domain), "--stock",
+                             "RoundPeg=3", "--lease", "0.5"});
+  Seen seen;
+  dds::QosSettings qos;
+  qos.liveliness_lease_s = 0.5;
+  auto participant = dds::make_participant("test-twin", {domain, true});
+  dds::Reader<cell::Capability, cell::CapabilityPubSubType> capabilities(
+      participant, "cell/capabilities", dds::TopicKind::state,
+      [&](const cell::Capability& c) { seen.add([&] { seen.capabilities.push_back(c); }); },
+      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id()); }); }, qos);
+  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+  CHECK(stock_of(seen.capabilities.back(), "RoundPeg") == 3);
+
+  const auto killed = std::chrono::steady_clock::now();
+  buffer.kill_hard();
+  REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));
+  const double noticed_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  CHECK(seen.gone.front() == "buffer-2");
+  CHECK(noticed_after < 5.0);  // bound, not a speed target: the lease is 0.5 s
+  test::clean_stale_dds_segments();  // what the killed process left behind
+}

@@ -48,6 +48,13 @@ class ChildProcess {
 
   pid_t pid() const { return pid_; }
 
+  // SIGKILL: the process gets no chance to say goodbye (a crash, a power cut).
+  void kill_hard() {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+
   // SIGTERM, then waits up to `timeout` for it to exit; its exit code, or -1 if it had to
   // be killed.
   int stop(std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
