@@ -3,6 +3,7 @@
 // stops. Bounded waits only; the process is always ended.
 
 #include <condition_variable>
+#include <memory>
 #include <mutex>
 
 #include <catch2/catch.hpp>
@@ -46,6 +47,19 @@ int stock_of(const cell::Capability& c, const std::string& type) {
   return -1;
 }
 
+using CapabilityReader = dds::Reader<cell::Capability, cell::CapabilityPubSubType>;
+
+// Watches cell/capabilities with the buffers' 0.5 s lease: states into seen.capabilities,
+// resources that disappear into seen.gone.
+std::unique_ptr<CapabilityReader> watch_capabilities(const dds::ParticipantPtr& participant, Seen& seen) {
+  dds::QosSettings qos;
+  qos.liveliness_lease_s = 0.5;
+  return std::make_unique<CapabilityReader>(
+      participant, "cell/capabilities", dds::TopicKind::state,
+      [&](const cell::Capability& c) { seen.add([&] { seen.capabilities.push_back(c); }); },
+      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id()); }); }, qos);
+}
+
 cell::Command give(const std::string& id, const std::string& part) {
   cell::Command c;
   c.command_id(id);
@@ -62,13 +76,8 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-1", "--domain", std::to_string(kDomain), "--stock",
                              "SquarePeg=1", "--lease", "0.5"});
   Seen seen;
-  dds::QosSettings qos;
-  qos.liveliness_lease_s = 0.5;
   auto participant = dds::make_participant("test-twin", {kDomain, true});
-  dds::Reader<cell::Capability, cell::CapabilityPubSubType> capabilities(
-      participant, "cell/capabilities", dds::TopicKind::state,
-      [&](const cell::Capability& c) { seen.add([&] { seen.capabilities.push_back(c); }); },
-      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id()); }); }, qos);
+  const auto capabilities = watch_capabilities(participant, seen);
   dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
       participant, "cell/command_events", dds::TopicKind::events,
       [&](const cell::CommandEvent& e) { seen.add([&] { seen.events.push_back(e); }); });
@@ -105,13 +114,8 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-2", "--domain", std::to_string(domain), "--stock",
                              "RoundPeg=3", "--lease", "0.5"});
   Seen seen;
-  dds::QosSettings qos;
-  qos.liveliness_lease_s = 0.5;
   auto participant = dds::make_participant("test-twin", {domain, true});
-  dds::Reader<cell::Capability, cell::CapabilityPubSubType> capabilities(
-      participant, "cell/capabilities", dds::TopicKind::state,
-      [&](const cell::Capability& c) { seen.add([&] { seen.capabilities.push_back(c); }); },
-      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id()); }); }, qos);
+  const auto capabilities = watch_capabilities(participant, seen);
   REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
   CHECK(stock_of(seen.capabilities.back(), "RoundPeg") == 3);
 

@@ -42,6 +42,7 @@ class Search {
   bool extend() {
     if (plan_.steps.size() == assembled_.size()) return true;
     if (failed_states_.count(assembled_)) return false;
+    const std::vector<PartIndex> allowed(scene_.frontier().begin(), scene_.frontier().end());
     for (PartIndex part : sequence_.candidates(scene_)) {
       std::vector<Attempt> tried;
       std::optional<Trajectory> trajectory;
@@ -59,7 +60,7 @@ class Search {
       }
       assembled_[part] = true;
       scene_.assemble(part);
-      plan_.steps.push_back({part, std::move(*trajectory), std::move(tried)});
+      plan_.steps.push_back({part, std::move(*trajectory), std::move(tried), allowed});
       if (extend()) return true;
       if (!sequence_.backtracks() || stopped_) return false;
       if (plan_.steps.size() > deepest_.size()) deepest_ = plan_.steps;  // the best partial plan, for the report
@@ -124,18 +125,15 @@ class Search {
 
   // Where the links left a choice: the designer steers the sequence through links (paper 5.2).
   void report_open_order() {
-    AssemblyScene replay(product_, options_.collision, options_.arm);
     for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
-      const auto& allowed = replay.frontier();
-      if (allowed.size() > 1) {
-        std::vector<std::string> names;
-        for (PartIndex p : allowed) names.push_back(name(p));
-        plan_.findings.push_back({"open-order",
-                                  "step " + std::to_string(i + 1) + ": the links allow any of " + join(names) +
-                                      "; the planner chose " + name(plan_.steps[i].part),
-                                  names});
-      }
-      replay.assemble(plan_.steps[i].part);
+      const auto& allowed = plan_.steps[i].allowed;
+      if (allowed.size() < 2) continue;
+      std::vector<std::string> names;
+      for (PartIndex p : allowed) names.push_back(name(p));
+      plan_.findings.push_back({"open-order",
+                                "step " + std::to_string(i + 1) + ": the links allow any of " + join(names) +
+                                    "; the planner chose " + name(plan_.steps[i].part),
+                                names});
     }
   }
 

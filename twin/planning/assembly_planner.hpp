@@ -17,6 +17,7 @@ struct PlanStep {
   PartIndex part = 0;
   Trajectory trajectory;
   std::vector<Attempt> failed;  // collided tries before the one that worked
+  std::vector<PartIndex> allowed;  // what the links allowed at this step (the part among them)
 };
 
 struct Finding {

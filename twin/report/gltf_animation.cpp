@@ -1,7 +1,6 @@
 #include "twin/report/gltf_animation.hpp"
 
 #include <algorithm>
-#include <cstring>
 #include <map>
 #include <stdexcept>
 
