@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "deploy/cellctl/plan_report.hpp"
+#include "twin/report/plan_json.hpp"
 #include "twin/geometry/product_loader.hpp"
 #include "twin/report/gltf_animation.hpp"
 
@@ -39,7 +40,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     print_plan(loaded.product, plan, std::cout);
     if (!options->json.empty()) {
       std::ofstream out(options->json);
-      out << plan_json(loaded.product, plan).dump(2) << '\n';
+      out << twin::plan_json(loaded.product, plan).dump(2) << '\n';
       if (!out) throw std::runtime_error("cannot write " + options->json);
       std::cout << "\nwrote " << options->json << '\n';
     }

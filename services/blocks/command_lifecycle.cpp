@@ -2,7 +2,7 @@
 
 namespace fb {
 
-CommandLifecycle::CommandLifecycle(std::string name) : BasicBlock(std::move(name), "IDLE") {
+CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : BasicBlock(std::move(name), "IDLE") {
   declare_input("COMMAND", {"command_id"});
   declare_input("PROGRESS", {"progress"});
   declare_input("DONE");
@@ -19,39 +19,60 @@ CommandLifecycle::CommandLifecycle(std::string name) : BasicBlock(std::move(name
   declare_output("CANCELED", {"command_id"});
   declare_output("REJECTED", {"command_id", "reason"});
 
-  const auto id = [this] { return Data{{"command_id", command_}}; };
   const auto is_current = [this](const Data& d) { return get<std::string>(d, "command_id") == command_; };
+  const auto queue_is_empty = [this](const Data&) { return queue_.empty(); };
 
-  transition("IDLE", "COMMAND", "EXECUTING", [this, id](const Data& d) {
+  transition("IDLE", "COMMAND", "EXECUTING", [this](const Data& d) {
     command_ = get<std::string>(d, "command_id");
-    emit("ACCEPTED", id());
-    emit("START", id());
+    emit("ACCEPTED", with_id({}));
+    emit("START", with_id({}));
   });
-  transition("EXECUTING", "PROGRESS", "EXECUTING", [this](const Data& d) {
-    emit("EXECUTING", {{"command_id", command_}, {"progress", get<double>(d, "progress")}});
-  });
-  transition("EXECUTING", "DONE", "IDLE", [this, id](const Data&) { emit("SUCCEEDED", id()); });
-  transition("EXECUTING", "FAIL", "IDLE", [this](const Data& d) {
-    emit("ABORTED", {{"command_id", command_}, {"reason", get<std::string>(d, "reason")}});
-  });
-  transition("EXECUTING", "CANCEL", "CANCELING", [this, id](const Data&) {
-    emit("CANCELING", id());
-    emit("STOP", id());
+  transition("EXECUTING", "PROGRESS", "EXECUTING", [this](const Data& d) { emit("EXECUTING", with_id(d)); });
+  // An outcome ends the command; the next queued one starts at once.
+  for (const char* state : {"EXECUTING", "CANCELING"}) {
+    transition(state, "DONE", "IDLE", [this](const Data& d) { emit("SUCCEEDED", with_id(d)); }, queue_is_empty);
+    transition(state, "DONE", "EXECUTING", [this](const Data& d) {
+      emit("SUCCEEDED", with_id(d));
+      start_next();
+    });
+    transition(state, "FAIL", "IDLE", [this](const Data& d) { emit("ABORTED", with_id(d)); }, queue_is_empty);
+    transition(state, "FAIL", "EXECUTING", [this](const Data& d) {
+      emit("ABORTED", with_id(d));
+      start_next();
+    });
+  }
+  transition("EXECUTING", "CANCEL", "CANCELING", [this](const Data&) {
+    emit("CANCELING", with_id({}));
+    emit("STOP", with_id({}));
   }, is_current);
-  transition("CANCELING", "STOPPED", "IDLE", [this, id](const Data&) { emit("CANCELED", id()); });
-  // The device may finish or fail before it could stop: that outcome stands.
-  transition("CANCELING", "DONE", "IDLE", [this, id](const Data&) { emit("SUCCEEDED", id()); });
-  transition("CANCELING", "FAIL", "IDLE", [this](const Data& d) {
-    emit("ABORTED", {{"command_id", command_}, {"reason", get<std::string>(d, "reason")}});
+  transition("CANCELING", "STOPPED", "IDLE", [this](const Data&) { emit("CANCELED", with_id({})); }, queue_is_empty);
+  transition("CANCELING", "STOPPED", "EXECUTING", [this](const Data&) {
+    emit("CANCELED", with_id({}));
+    start_next();
   });
-  // One command at a time: another one is refused, never queued behind the current one.
   for (const char* busy : {"EXECUTING", "CANCELING"}) {
-    transition(busy, "COMMAND", busy, [this](const Data& d) { reject(d); });
+    if (when_busy == WhenBusy::queue) {
+      transition(busy, "COMMAND", busy, [this](const Data& d) {
+        queue_.push_back(get<std::string>(d, "command_id"));
+        emit("ACCEPTED", {{"command_id", queue_.back()}});
+      });
+    } else {
+      transition(busy, "COMMAND", busy, [this](const Data& d) {
+        emit("REJECTED", {{"command_id", get<std::string>(d, "command_id")}, {"reason", "busy with " + command_}});
+      });
+    }
   }
 }
 
-void CommandLifecycle::reject(const Data& data) {
-  emit("REJECTED", {{"command_id", get<std::string>(data, "command_id")}, {"reason", "busy with " + command_}});
+Data CommandLifecycle::with_id(Data data) const {
+  data["command_id"] = command_;
+  return data;
+}
+
+void CommandLifecycle::start_next() {
+  command_ = queue_.front();
+  queue_.pop_front();
+  emit("START", with_id({}));
 }
 
 }  // namespace fb

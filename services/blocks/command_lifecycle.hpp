@@ -1,17 +1,24 @@
 #pragma once
-// The life cycle of one command on one resource, as a ROS 2 action goal has it: accepted,
+// The life cycle of commands on one resource, as a ROS 2 action goal has it: accepted,
 // executing (with progress), canceling, and succeeded, canceled or aborted. A resource
 // service puts this block between its command topic and the block that drives its device;
-// it knows nothing about what the command does.
+// it knows nothing about what a command does. One command executes at a time; the others
+// are refused (a device that cannot wait) or queued in arrival order (a device with a work
+// queue, such as a mobile robot).
 //
 //   inputs                         outputs
-//   COMMAND  (command_id)          ACCEPTED, START       (command_id)
-//   PROGRESS (progress)            EXECUTING             (command_id, progress)
-//   DONE                           SUCCEEDED             (command_id)
-//   FAIL     (reason)              ABORTED               (command_id, reason)
-//   CANCEL   (command_id)          CANCELING, STOP       (command_id)
-//   STOPPED                        CANCELED              (command_id)
+//   COMMAND  (command_id)          ACCEPTED              (command_id)
+//   PROGRESS (progress, ...)       START                 (command_id)
+//   DONE     (...)                 EXECUTING             (command_id, progress, ...)
+//   FAIL     (reason, ...)         SUCCEEDED             (command_id, ...)
+//   CANCEL   (command_id)          ABORTED               (command_id, reason, ...)
+//   STOPPED                        CANCELING, STOP       (command_id)
+//                                  CANCELED              (command_id)
 //                                  REJECTED              (command_id, reason)
+// Data the device adds to PROGRESS, DONE and FAIL (a sim time, a distance) goes out with
+// the event they cause.
+
+#include <deque>
 
 #include "services/runtime/basic_block.hpp"
 
@@ -19,11 +26,16 @@ namespace fb {
 
 class CommandLifecycle : public BasicBlock {
  public:
-  explicit CommandLifecycle(std::string name);
+  enum class WhenBusy { reject, queue };
+  explicit CommandLifecycle(std::string name, WhenBusy when_busy = WhenBusy::reject);
+
+  std::size_t queued() const { return queue_.size(); }
 
  private:
-  void reject(const Data& data);
+  Data with_id(Data data) const;
+  void start_next();
   std::string command_;
+  std::deque<std::string> queue_;
 };
 
 }  // namespace fb

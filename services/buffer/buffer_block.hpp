@@ -1,30 +1,24 @@
 #pragma once
-// A part buffer: holds counts of part types and gives one part per command. It knows no
-// products: a part type is a name.
+// A part buffer: holds counts of part types and gives one part per "give" command. It knows
+// no products: a part type is a name.
 //
-//   inputs                               outputs
-//   COMMAND (command_id, resource_id,    ACCEPT (command_id): for the life cycle, when the
-//            operation, part)                                 command is for this buffer
-//   START   (command_id)                 DONE, FAIL (reason): back to the life cycle
-//                                        STOCK (): the stock changed
+//   START (part_type)  ->  DONE, CAPABILITY (the stock changed)  or  FAIL (reason)
 
 #include <map>
 #include <string>
 
-#include "services/runtime/basic_block.hpp"
+#include "services/node/device_block.hpp"
 
 namespace fb {
 
-class BufferBlock : public BasicBlock {
+class BufferBlock : public DeviceBlock {
  public:
   BufferBlock(std::string name, std::string resource_id, std::map<std::string, int> stock);
   const std::map<std::string, int>& stock() const { return stock_; }
-  const std::string& resource_id() const { return resource_id_; }
+  int count(const std::string& part_type) const;
 
  private:
-  std::string resource_id_;
   std::map<std::string, int> stock_;
-  std::map<std::string, std::string> part_of_command_;
 };
 
 }  // namespace fb

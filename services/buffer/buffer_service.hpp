@@ -1,26 +1,25 @@
 #pragma once
-// The buffer service: a BufferBlock behind a CommandLifecycle, bound to the cell's command,
-// command-event and capability topics. One resource, one queue.
+// The buffer service: a BufferBlock on a resource node (commands, life cycle, contract net,
+// capability with its stock). One resource, one queue. Buffers are shared: every order may
+// take parts from them.
 
 #include <map>
 #include <memory>
 #include <string>
 
-#include "services/dds/participant.hpp"
-#include "services/runtime/resource.hpp"
+#include "services/node/resource_node.hpp"
 
 namespace services {
 
 struct BufferConfig {
-  std::string id;
+  NodeConfig node;
   std::map<std::string, int> stock;
   dds::ParticipantSettings dds;
-  double liveliness_lease_s = 2.0;
 };
 
 class BufferService {
  public:
-  explicit BufferService(const BufferConfig& config);
+  explicit BufferService(BufferConfig config);
   ~BufferService();
   // Delivers events until `keep_running` turns false (checked every 100 ms).
   template <class Flag>
@@ -29,9 +28,8 @@ class BufferService {
   }
 
  private:
-  struct Impl;
   fb::Resource resource_;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<ResourceNode> node_;
 };
 
 }  // namespace services

@@ -18,10 +18,11 @@ int main(int argc, char** argv) {
   CLI::App app{"buffer: a part buffer of the assembly cell"};
   services::BufferConfig config;
   std::vector<std::string> stock;
-  app.add_option("--id", config.id, "Resource id")->required();
+  app.add_option("--id", config.node.id, "Resource id")->required();
   app.add_option("--domain", config.dds.domain_id, "DDS domain id")->required();
   app.add_option("--stock", stock, "TYPE=COUNT, repeatable");
-  app.add_option("--lease", config.liveliness_lease_s, "Liveliness lease of the capability, s");
+  app.add_option("--position", config.node.position, "Where it stands: x y z, m");
+  app.add_option("--lease", config.node.liveliness_lease_s, "Liveliness lease of the capability, s");
   try {
     app.parse(argc, argv);
     for (const auto& s : stock) {
@@ -39,10 +40,10 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, stop);
   try {
     services::BufferService service(config);
-    std::cout << "buffer " << config.id << " ready on domain " << config.dds.domain_id << std::endl;
+    std::cout << "buffer " << config.node.id << " ready on domain " << config.dds.domain_id << std::endl;
     service.run(running);
   } catch (const std::exception& e) {
-    std::cerr << "error: buffer " << config.id << ": " << e.what() << '\n';
+    std::cerr << "error: buffer " << config.node.id << ": " << e.what() << '\n';
     return 1;
   }
   return 0;

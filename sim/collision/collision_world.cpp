@@ -69,6 +69,8 @@ void MovingBody::add_box(const std::string& member, const Eigen::Vector3d& half_
   impl_->add(member, std::move(box), offset);
 }
 
+bool MovingBody::empty() const { return impl_->shapes.empty(); }
+
 // --- CollisionWorld -----------------------------------------------------------------------
 
 struct CollisionWorld::Impl {

@@ -50,6 +50,7 @@ class MovingBody {
   // Largest distance of any point from the body's origin: bounds how far points move when
   // it turns.
   double radius() const { return radius_; }
+  bool empty() const;
 
  private:
   friend class CollisionWorld;

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "services/blocks/command_lifecycle.hpp"
+#include "services/blocks/contractor.hpp"
 #include "services/runtime/block_test_fixture.hpp"
 
 namespace {
@@ -140,4 +141,73 @@ TEST_CASE("events posted from another thread arrive in order", "[fb][threads]") 
   producer.join();
   CHECK(delivered == 1000);
   CHECK(a.count == 1000 * 1001 / 2);
+}
+
+TEST_CASE("command life cycle with a queue: one executes, the rest wait their turn in order", "[fb][lifecycle]") {
+  fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle", fb::CommandLifecycle::WhenBusy::queue);
+  f.send("COMMAND", {{"command_id", std::string("c1")}});
+  CHECK(names<fb::CommandLifecycle>(f.send("COMMAND", {{"command_id", std::string("c2")}})) == Names{"ACCEPTED"});
+  f.send("COMMAND", {{"command_id", std::string("c3")}});
+  CHECK(f.block().queued() == 2);
+  const auto done = f.send("DONE", {{"distance", 1.5}});
+  REQUIRE(names<fb::CommandLifecycle>(done) == Names{"SUCCEEDED", "START"});
+  CHECK(fb::get<std::string>(done[0].data, "command_id") == "c1");
+  CHECK(fb::get<double>(done[0].data, "distance") == 1.5);  // the device's data goes along
+  CHECK(fb::get<std::string>(done[1].data, "command_id") == "c2");
+  const auto failed = f.send("FAIL", {{"reason", std::string("buffer-1 has no Peg")}});
+  REQUIRE(names<fb::CommandLifecycle>(failed) == Names{"ABORTED", "START"});
+  CHECK(fb::get<std::string>(failed[1].data, "command_id") == "c3");
+  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED"});
+  CHECK(f.block().state() == "IDLE");
+}
+
+namespace {
+fb::Data cfp(const std::string& order, const std::string& operation) {
+  return {{"call_id", order + "/" + operation}, {"order_id", order}, {"operation", operation},
+          {"part_type", std::string()}};
+}
+fb::Data award(const std::string& order, const std::string& operation) {
+  return {{"call_id", order + "/" + operation}, {"resource_id", std::string("arm-1")}, {"order_id", order}};
+}
+fb::Contractor::CanServe moves_only() {
+  return [](const std::string& operation, const std::string&) { return operation == "translate"; };
+}
+}  // namespace
+
+TEST_CASE("contractor: proposes what it can serve, and is reserved by the order it confirms", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Contractor> f("contractor", "arm-1", true, moves_only(), 2.0);
+  CHECK(f.send("CFP", cfp("o1", "fetch")).empty());
+  const auto proposal = f.send("CFP", cfp("o1", "translate"));
+  REQUIRE(names<fb::Contractor>(proposal) == Names{"PROPOSE"});
+  CHECK(fb::get<double>(proposal[0].data, "duration") == 2.0);
+  const auto confirmed = f.send("AWARD", award("o1", "translate"));
+  REQUIRE(names<fb::Contractor>(confirmed) == Names{"REPLY", "RESERVED"});
+  CHECK(fb::get<bool>(confirmed[0].data, "confirmed"));
+  CHECK(f.block().reserved_by() == "o1");
+
+  CHECK(f.send("CFP", cfp("o2", "translate")).empty());  // reserved: another order hears nothing
+  const auto refused = f.send("AWARD", award("o2", "translate"));
+  REQUIRE(names<fb::Contractor>(refused) == Names{"REPLY"});
+  CHECK_FALSE(fb::get<bool>(refused[0].data, "confirmed"));
+  CHECK(fb::get<std::string>(refused[0].data, "reason") == "arm-1 is reserved by order o1");
+
+  CHECK(f.send("ORDER_ENDED", {{"order_id", std::string("o2")}}).empty());
+  const auto freed = f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
+  REQUIRE(names<fb::Contractor>(freed) == Names{"RESERVED"});
+  CHECK(fb::get<std::string>(freed[0].data, "order_id").empty());
+  CHECK(names<fb::Contractor>(f.send("CFP", cfp("o2", "translate"))) == Names{"PROPOSE"});
+}
+
+TEST_CASE("contractor: a shared resource confirms every order, and a release frees the holder", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Contractor> shared("contractor", "arm-1", false, moves_only());
+  CHECK(fb::get<bool>(shared.send("AWARD", award("o1", "translate"))[0].data, "confirmed"));
+  CHECK(fb::get<bool>(shared.send("AWARD", award("o2", "translate"))[0].data, "confirmed"));
+  CHECK(shared.block().reserved_by().empty());
+
+  fb::BlockTestFixture<fb::Contractor> exclusive("contractor", "arm-1", true, moves_only());
+  exclusive.send("AWARD", award("o1", "translate"));
+  CHECK(exclusive.send("RELEASE", {{"order_id", std::string("o2")}, {"resource_id", std::string("arm-1")}}).empty());
+  CHECK(names<fb::Contractor>(exclusive.send(
+            "RELEASE", {{"order_id", std::string("o1")}, {"resource_id", std::string("arm-1")}})) == Names{"RESERVED"});
+  CHECK(exclusive.block().reserved_by().empty());
 }

@@ -1,0 +1,152 @@
+#include "services/dds/conversions.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace dds {
+
+fb::Numbers to_numbers(const std::vector<cell::Pose>& path) {
+  fb::Numbers out;
+  for (const auto& p : path) {
+    out.insert(out.end(), {p.position().x(), p.position().y(), p.position().z(), p.qw(), p.qx(), p.qy(), p.qz()});
+  }
+  return out;
+}
+
+std::vector<cell::Pose> to_path(const fb::Numbers& n) {
+  if (n.size() % 7 != 0) throw std::invalid_argument("a path needs seven numbers per pose, got " + std::to_string(n.size()));
+  std::vector<cell::Pose> path(n.size() / 7);
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const double* v = &n[7 * i];
+    path[i].position(vec3(v[0], v[1], v[2]));
+    path[i].qw(v[3]);
+    path[i].qx(v[4]);
+    path[i].qy(v[5]);
+    path[i].qz(v[6]);
+  }
+  return path;
+}
+
+fb::Numbers to_numbers(const cell::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+cell::Vec3 to_vec3(const fb::Numbers& n) {
+  if (n.size() != 3) throw std::invalid_argument("a vector needs three numbers, got " + std::to_string(n.size()));
+  return vec3(n[0], n[1], n[2]);
+}
+
+cell::Vec3 vec3(double x, double y, double z) {
+  cell::Vec3 v;
+  v.x(x);
+  v.y(y);
+  v.z(z);
+  return v;
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ",") + n;
+  return out;
+}
+
+std::vector<std::string> split(const std::string& joined) {
+  std::vector<std::string> out;
+  std::stringstream in(joined);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+}  // namespace dds
+
+namespace dds {
+
+fb::Data to_data(const cell::Command& c) {
+  return {{"command_id", c.command_id()},   {"resource_id", c.resource_id()}, {"order_id", c.order_id()},
+          {"operation", c.operation()},     {"part", c.part()},               {"part_type", c.part_type()},
+          {"source", c.source()},           {"destination", c.destination()}, {"path", to_numbers(c.path())},
+          {"size", to_numbers(c.size())},   {"direction", to_numbers(c.direction())},
+          {"sim_time", c.sim_time()}};
+}
+
+cell::Command to_command(const fb::Data& d) {
+  const auto text = [&](const char* key) { return fb::get_or<std::string>(d, key, ""); };
+  cell::Command c;
+  c.command_id(text("command_id"));
+  c.resource_id(text("resource_id"));
+  c.order_id(text("order_id"));
+  c.operation(text("operation"));
+  c.part(text("part"));
+  c.part_type(text("part_type"));
+  c.source(text("source"));
+  c.destination(text("destination"));
+  c.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
+  c.size(to_vec3(fb::get_or<fb::Numbers>(d, "size", {0, 0, 0})));
+  c.direction(to_vec3(fb::get_or<fb::Numbers>(d, "direction", {0, 0, 0})));
+  c.sim_time(fb::get_or<double>(d, "sim_time", 0));
+  return c;
+}
+
+fb::Data to_data(const cell::SimReply& r) {
+  return {{"request_id", r.request_id()}, {"requester", r.requester()}, {"ok", r.ok()}, {"error", r.error()},
+          {"collided", r.collided()},     {"hit_body", r.hit_body()}, {"hit_member", r.hit_member()},
+          {"depth", r.depth()},           {"start_time", r.start_time()}, {"end_time", r.end_time()},
+          {"distance", r.distance()}};
+}
+
+cell::SimRequest to_sim_request(const fb::Data& d) {
+  const auto text = [&](const char* key) { return fb::get_or<std::string>(d, key, ""); };
+  cell::SimRequest r;
+  r.request_id(text("request_id"));
+  r.requester(text("requester"));
+  r.kind(text("kind"));
+  r.body_id(text("body_id"));
+  r.mesh_uri(text("mesh_uri"));
+  r.half_extents(to_vec3(fb::get_or<fb::Numbers>(d, "half_extents", {0, 0, 0})));
+  const auto placement = to_path(fb::get_or<fb::Numbers>(d, "placement", {0, 0, 0, 1, 0, 0, 0}));
+  if (placement.size() != 1) throw std::invalid_argument("a placement is one pose");
+  r.placement(placement.front());
+  r.is_static(fb::get_or<bool>(d, "is_static", false));
+  r.carried(split(text("carried")));
+  r.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
+  r.speed(fb::get_or<double>(d, "speed", 0));
+  r.angular_speed(fb::get_or<double>(d, "angular_speed", 0));
+  return r;
+}
+
+}  // namespace dds
+
+namespace dds {
+
+fb::Data to_data(const cell::SimRequest& r) {
+  return {{"request_id", r.request_id()},
+          {"requester", r.requester()},
+          {"kind", r.kind()},
+          {"body_id", r.body_id()},
+          {"mesh_uri", r.mesh_uri()},
+          {"half_extents", to_numbers(r.half_extents())},
+          {"placement", to_numbers(std::vector<cell::Pose>{r.placement()})},
+          {"is_static", r.is_static()},
+          {"carried", join(r.carried())},
+          {"path", to_numbers(r.path())},
+          {"speed", r.speed()},
+          {"angular_speed", r.angular_speed()}};
+}
+
+cell::SimReply to_sim_reply(const fb::Data& d) {
+  cell::SimReply r;
+  r.request_id(fb::get<std::string>(d, "request_id"));
+  r.requester(fb::get_or<std::string>(d, "requester", ""));
+  r.ok(fb::get_or<bool>(d, "ok", false));
+  r.error(fb::get_or<std::string>(d, "error", ""));
+  r.collided(fb::get_or<bool>(d, "collided", false));
+  r.hit_body(fb::get_or<std::string>(d, "hit_body", ""));
+  r.hit_member(fb::get_or<std::string>(d, "hit_member", ""));
+  r.depth(fb::get_or<double>(d, "depth", 0));
+  r.start_time(fb::get_or<double>(d, "start_time", 0));
+  r.end_time(fb::get_or<double>(d, "end_time", 0));
+  r.distance(fb::get_or<double>(d, "distance", 0));
+  return r;
+}
+
+}  // namespace dds

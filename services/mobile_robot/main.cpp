@@ -1,0 +1,83 @@
+// mobile-robot: fetches parts from buffers to a station, one after another in the order the
+// fetch commands came. Learns where buffers and stations hand parts over from their
+// capabilities; asks a buffer for a part with a "give" command.
+//   mobile-robot --domain 42 --id mobile-robot-1 --home 1.5 0 1.2 --speed 0.8
+
+#include <csignal>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "services/dds/conversions.hpp"
+#include "services/dds/service_blocks.hpp"
+#include "services/mobile_robot/mobile_robot_block.hpp"
+#include "services/node/resource_node.hpp"
+#include "services/node/run.hpp"
+
+namespace {
+volatile std::sig_atomic_t running = 1;
+void stop(int) { running = 0; }
+
+const char* state_name(cell::CommandState s) {
+  switch (s) {
+    case cell::ACCEPTED: return "accepted";
+    case cell::EXECUTING: return "executing";
+    case cell::CANCELING: return "canceling";
+    case cell::SUCCEEDED: return "succeeded";
+    case cell::CANCELED: return "canceled";
+    case cell::ABORTED: return "aborted";
+  }
+  return "unknown";
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mobile-robot: fetches parts from buffers to the station"};
+  dds::ParticipantSettings dds;
+  services::NodeConfig config{"mobile-robot-1", "mobile-robot"};
+  config.speed = 0.8;
+  config.when_busy = fb::CommandLifecycle::WhenBusy::queue;
+  app.add_option("--domain", dds.domain_id, "DDS domain id")->required();
+  app.add_option("--id", config.id, "Resource id");
+  app.add_option("--home", config.position, "Where it waits: x y z, m");
+  app.add_option("--speed", config.speed, "m/s")->check(CLI::PositiveNumber);
+  app.add_option("--lease", config.liveliness_lease_s, "Liveliness lease of the capability, s");
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGINT, stop);
+  std::signal(SIGTERM, stop);
+  try {
+    auto participant = dds::make_participant(config.id, dds);
+    fb::Resource resource(config.id, 1024);
+    auto& robot = resource.add(std::make_unique<fb::MobileRobotBlock>(
+        "robot", config.id, fb::Numbers(config.position.begin(), config.position.end()), config.speed));
+    services::ResourceNode node(resource, participant, config, robot,
+                                [](const std::string& op, const std::string&) { return op == "fetch"; });
+    auto& places = resource.add(std::make_unique<dds::SubscribeBlock<cell::Capability, cell::CapabilityPubSubType>>(
+        "places", participant, "cell/capabilities", dds::TopicKind::state, [](const cell::Capability& c) {
+          return fb::Data{{"resource_id", c.resource_id()}, {"dock", dds::to_numbers(c.dock())}};
+        }));
+    auto& give_events = resource.add(std::make_unique<dds::SubscribeBlock<cell::CommandEvent, cell::CommandEventPubSubType>>(
+        "give_events", participant, "cell/command_events", dds::TopicKind::events, [](const cell::CommandEvent& e) {
+          return fb::Data{{"command_id", e.command_id()}, {"state", std::string(state_name(e.state()))},
+                          {"reason", e.reason()}};
+        }));
+    resource.add(std::make_unique<dds::PublishBlock<cell::Command, cell::CommandPubSubType>>(
+        "gives", participant, "cell/commands", dds::TopicKind::events,
+        [](const fb::Data& d) { return dds::to_command(d); }));
+    resource.connect("places", "IND", "robot", "PLACE");
+    resource.connect("give_events", "IND", "robot", "GIVE_EVENT");
+    resource.connect("robot", "GIVE", "gives", "REQ");
+    node.start();
+    places.start();
+    give_events.start();
+    resource.post("robot", "INIT");
+    std::cout << "mobile-robot " << config.id << " ready on domain " << dds.domain_id << std::endl;
+    services::run_until_stopped({&resource}, running);
+  } catch (const std::exception& e) {
+    std::cerr << "error: mobile-robot " << config.id << ": " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,86 @@
+#include "services/mobile_robot/mobile_robot_block.hpp"
+
+namespace fb {
+
+MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers home, double speed)
+    : DeviceBlock(std::move(name), id, {"fetch"}, "INIT"), sim_(id), speed_(speed) {
+  declare_input("INIT");
+  declare_input("PLACE", {"resource_id", "dock"});
+  declare_input("SIM_REPLY", {"request_id", "ok"});
+  declare_input("GIVE_EVENT", {"command_id", "state", "reason"});
+  declare_output("SIM", {"request_id", "kind", "body_id"});
+  declare_output("GIVE", {"command_id", "resource_id", "operation", "part_type"});
+
+  const auto answered = [this](const Data& d) { return sim_.answers_last(d); };
+  const auto arrived = [this](const Data& d) {
+    return sim_.answers_last(d) && get<bool>(d, "ok") && !get_or<bool>(d, "collided", false);
+  };
+  // Adds a move's distance and time to the fetch's; on failure, the fetch fails with why.
+  const auto account = [this](const Data& reply) {
+    std::string failure;
+    Data outcome = move_outcome(reply, failure);
+    distance_ += get<double>(outcome, "distance");
+    moving_ += get<double>(outcome, "duration");
+    outcome["distance"] = distance_;
+    outcome["duration"] = moving_;
+    return outcome;
+  };
+  const auto fail = [this, account](const Data& reply) { emit("FAIL", account(reply)); };
+  const auto give_answer = [this](const char* state) {
+    return [this, state](const Data& d) {
+      return get<std::string>(d, "command_id") == give_id_ && get<std::string>(d, "state") == state;
+    };
+  };
+
+  for (const char* state : {"INIT", "SPAWNING", "READY", "TO_SOURCE", "WAIT_GIVE", "TO_DESTINATION"}) {
+    transition(state, "PLACE", state, [this](const Data& d) {
+      docks_[get<std::string>(d, "resource_id")] = get<Numbers>(d, "dock");
+    });
+  }
+  transition("INIT", "INIT", "SPAWNING", [this, home](const Data&) {
+    emit("SIM", sim_.spawn(body(), {home[0], home[1], home[2], 1, 0, 0, 0}, {0, 0, 0}, false));
+  });
+  transition("SPAWNING", "SIM_REPLY", "READY", {}, answered);
+
+  const auto knows_places = [this](const Data& d) {
+    return docks_.count(get<std::string>(d, "source")) && docks_.count(get<std::string>(d, "destination"));
+  };
+  transition("READY", "START", "TO_SOURCE", [this](const Data& d) {
+    fetch_ = d;
+    distance_ = moving_ = 0;
+    emit("PROGRESS", {{"progress", 0.0}});
+    drive_to(get<std::string>(d, "source"), {});
+  }, knows_places);
+  transition("READY", "START", "READY", [this](const Data& d) {
+    emit("FAIL", {{"reason", "no dock known for " + get<std::string>(d, "source") + " or " +
+                                 get<std::string>(d, "destination")}});
+  });
+  transition("TO_SOURCE", "SIM_REPLY", "WAIT_GIVE", [this, account](const Data& reply) {
+    account(reply);
+    give_id_ = get<std::string>(fetch_, "command_id") + "/give";
+    emit("GIVE", {{"command_id", give_id_},
+                  {"resource_id", fetch_.at("source")},
+                  {"order_id", fetch_.at("order_id")},
+                  {"operation", std::string("give")},
+                  {"part", fetch_.at("part")},
+                  {"part_type", fetch_.at("part_type")},
+                  {"sim_time", get<double>(reply, "end_time")}});
+  }, arrived);
+  transition("TO_SOURCE", "SIM_REPLY", "READY", fail, answered);
+  transition("WAIT_GIVE", "GIVE_EVENT", "TO_DESTINATION", [this](const Data&) {
+    drive_to(get<std::string>(fetch_, "destination"), {get<std::string>(fetch_, "part")});
+  }, give_answer("succeeded"));
+  transition("WAIT_GIVE", "GIVE_EVENT", "READY", [this](const Data& d) {
+    emit("FAIL", {{"reason", get<std::string>(d, "reason")}, {"distance", distance_}, {"duration", moving_}});
+  }, give_answer("aborted"));
+  transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, account](const Data& reply) { emit("DONE", account(reply)); },
+             arrived);
+  transition("TO_DESTINATION", "SIM_REPLY", "READY", fail, answered);
+}
+
+void MobileRobotBlock::drive_to(const std::string& place, const std::vector<std::string>& carried) {
+  const Numbers& dock = docks_.at(place);
+  emit("SIM", sim_.move(body(), carried, {dock[0], 0, dock[2], 1, 0, 0, 0}, speed_, 0));
+}
+
+}  // namespace fb

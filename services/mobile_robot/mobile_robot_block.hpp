@@ -1,0 +1,36 @@
+#pragma once
+// The mobile robot: a queue of parts to fetch (the life cycle queues the commands; this block
+// runs one at a time). For each: drive to the buffer's dock, ask the buffer for a part of the
+// type, drive to the station's dock carrying it; the command succeeds on delivery. It knows
+// no products: a part is a body id and a type name; places are docks from capabilities.
+//
+//   INIT -> SIM (spawn its body at home) -> READY
+//   START fetch (part, part_type, source, destination)
+//     -> SIM move to the source's dock -> GIVE (a "give" command to the source)
+//     -> GIVE_EVENT succeeded -> SIM move to the destination's dock carrying the part -> DONE
+//   PLACE (resource_id, dock): where a resource hands parts over
+
+#include <map>
+
+#include "services/node/device_block.hpp"
+#include "services/node/sim_requests.hpp"
+
+namespace fb {
+
+class MobileRobotBlock : public DeviceBlock {
+ public:
+  MobileRobotBlock(std::string name, std::string resource_id, Numbers home, double speed);
+
+ private:
+  void drive_to(const std::string& place, const std::vector<std::string>& carried);
+  std::string body() const { return resource_id() + "/base"; }
+
+  SimRequests sim_;
+  double speed_;
+  std::map<std::string, Numbers> docks_;
+  Data fetch_;          // the command being executed
+  std::string give_id_;
+  double distance_ = 0, moving_ = 0;  // so far in this fetch
+};
+
+}  // namespace fb

@@ -1,0 +1,44 @@
+#include "services/node/device_block.hpp"
+
+namespace fb {
+
+DeviceBlock::DeviceBlock(std::string name, std::string resource_id, std::set<std::string> operations,
+                         std::string initial_state)
+    : BasicBlock(std::move(name), std::move(initial_state)), resource_id_(std::move(resource_id)),
+      operations_(std::move(operations)) {
+  declare_input("COMMAND", {"command_id", "resource_id", "operation"});
+  declare_input("START", {"command_id"});
+  declare_output("ACCEPT", {"command_id"});
+  declare_output("PROGRESS", {"progress"});
+  declare_output("DONE");
+  declare_output("FAIL", {"reason"});
+}
+
+const Data& DeviceBlock::command(const std::string& command_id) const {
+  static const Data none;
+  const auto it = commands_.find(command_id);
+  return it == commands_.end() ? none : it->second;
+}
+
+void DeviceBlock::receive(const Event& event) {
+  if (event.name == "COMMAND") {
+    if (get<std::string>(event.data, "resource_id") != resource_id_) return;
+    // Every command for this resource is accepted; one for an operation it lacks fails at
+    // START with the reason, so the sender hears why.
+    const std::string& id = get<std::string>(event.data, "command_id");
+    commands_[id] = event.data;
+    emit("ACCEPT", {{"command_id", id}});
+    return;
+  }
+  if (event.name == "START") {
+    Data full = command(get<std::string>(event.data, "command_id"));
+    if (full.empty()) return emit("FAIL", {{"reason", std::string("unknown command")}});
+    if (!operations_.count(get<std::string>(full, "operation"))) {
+      return emit("FAIL", {{"reason", resource_id_ + " cannot " + get<std::string>(full, "operation")}});
+    }
+    return BasicBlock::receive({"START", std::move(full)});
+  }
+  BasicBlock::receive(event);
+}
+
+}  // namespace fb

@@ -1,0 +1,40 @@
+#pragma once
+// The block that drives a resource's device (a buffer's stock, an arm, a mobile robot). It
+// takes the commands addressed to its resource for operations it has, remembers them, and
+// hands them to the command life cycle; when the life cycle starts one, the device's ECC
+// gets START with the whole command (operation, part, path, ...), and answers with DONE or
+// FAIL (and PROGRESS while it works).
+//
+//   inputs                                  outputs
+//   COMMAND (command_id, resource_id,       ACCEPT   (command_id)    to the life cycle
+//            operation, ...)                PROGRESS, DONE, FAIL     to the life cycle
+//   START   (command_id) -> the ECC's START with the command's data
+// A device adds its own inputs and outputs (replies from cell-sim, requests to it).
+
+#include <map>
+#include <set>
+
+#include "services/runtime/basic_block.hpp"
+
+namespace fb {
+
+class DeviceBlock : public BasicBlock {
+ public:
+  DeviceBlock(std::string name, std::string resource_id, std::set<std::string> operations,
+              std::string initial_state = "READY");
+
+  const std::string& resource_id() const { return resource_id_; }
+  const std::set<std::string>& operations() const { return operations_; }
+  // The command as it came (empty when unknown); forget() once its last event is out.
+  const Data& command(const std::string& command_id) const;
+  void forget(const std::string& command_id) { commands_.erase(command_id); }
+
+  void receive(const Event& event) override;
+
+ private:
+  std::string resource_id_;
+  std::set<std::string> operations_;
+  std::map<std::string, Data> commands_;
+};
+
+}  // namespace fb

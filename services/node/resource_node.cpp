@@ -1,0 +1,216 @@
+#include "services/node/resource_node.hpp"
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "negotiationPubSubTypes.h"
+#include "ordersPubSubTypes.h"
+#include "services/blocks/action_block.hpp"
+#include "services/dds/conversions.hpp"
+#include "services/dds/service_blocks.hpp"
+#include "simulationPubSubTypes.h"
+
+namespace services {
+namespace {
+
+using dds::TopicKind;
+template <class T, class P>
+using Sub = dds::SubscribeBlock<T, P>;
+template <class T, class P>
+using Pub = dds::PublishBlock<T, P>;
+
+const std::pair<const char*, cell::CommandState> kLifecycleOutputs[] = {
+    {"ACCEPTED", cell::ACCEPTED}, {"EXECUTING", cell::EXECUTING}, {"SUCCEEDED", cell::SUCCEEDED},
+    {"ABORTED", cell::ABORTED},   {"REJECTED", cell::ABORTED},    {"CANCELING", cell::CANCELING},
+    {"CANCELED", cell::CANCELED}};
+
+bool is_final(cell::CommandState s) { return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED; }
+
+// Order status -> ORDER_ENDED when an order is done, failed, or its twin is gone.
+class OrderWatch : public fb::FunctionBlock {
+ public:
+  OrderWatch() : FunctionBlock("order_watch") {
+    declare_input("STATUS", {"order_id", "ended"});
+    declare_input("GONE", {"order_id"});
+    declare_output("ENDED", {"order_id"});
+  }
+  void receive(const fb::Event& e) override {
+    if (e.name == "GONE" || fb::get<bool>(e.data, "ended")) emit("ENDED", {{"order_id", e.data.at("order_id")}});
+  }
+};
+
+}  // namespace
+
+struct ResourceNode::Impl {
+  fb::Resource& resource;
+  dds::ParticipantPtr participant;
+  NodeConfig config;
+  fb::DeviceBlock& device;
+  fb::Contractor* contractor = nullptr;
+  std::function<void(cell::Capability&)> describe;
+  dds::SimClock clock;
+  std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
+  std::vector<std::function<void()>> starters;
+  Pub<cell::SimRequest, cell::SimRequestPubSubType>* sim_requests = nullptr;
+
+  Impl(fb::Resource& r, dds::ParticipantPtr p, NodeConfig c, fb::DeviceBlock& d)
+      : resource(r), participant(p), config(std::move(c)), device(d), clock(p) {}
+
+  template <class T, class P>
+  Sub<T, P>& subscribe(const std::string& name, const std::string& topic, TopicKind kind,
+                       typename Sub<T, P>::ToData to_data) {
+    auto& block = resource.add(std::make_unique<Sub<T, P>>(name, participant, topic, kind, std::move(to_data)));
+    starters.push_back([&block] { block.start(); });
+    return block;
+  }
+  template <class T, class P>
+  void publish(const std::string& name, const std::string& topic, typename Pub<T, P>::ToSample to_sample) {
+    resource.add(std::make_unique<Pub<T, P>>(name, participant, topic, TopicKind::events, std::move(to_sample)));
+  }
+
+  cell::CommandEvent event_of(cell::CommandState state, const fb::Data& d) {
+    const std::string& id = fb::get<std::string>(d, "command_id");
+    const fb::Data& command = device.command(id);
+    cell::CommandEvent e;
+    e.command_id(id);
+    e.resource_id(config.id);
+    e.order_id(fb::get_or<std::string>(command, "order_id", ""));
+    e.operation(fb::get_or<std::string>(command, "operation", ""));
+    e.part(fb::get_or<std::string>(command, "part", ""));
+    e.state(state);
+    e.progress(fb::get_or<double>(d, "progress", state == cell::SUCCEEDED ? 1.0 : 0.0));
+    e.reason(fb::get_or<std::string>(d, "reason", ""));
+    e.distance(fb::get_or<double>(d, "distance", 0));
+    e.duration(fb::get_or<double>(d, "duration", 0));
+    clock.observe(fb::get_or<double>(command, "sim_time", 0));
+    if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
+    e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
+    if (is_final(state)) device.forget(id);
+    return e;
+  }
+};
+
+ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participant, NodeConfig config,
+                           fb::DeviceBlock& device, fb::Contractor::CanServe can_serve, std::function<void(cell::Capability&)> describe)
+    : impl_(std::make_unique<Impl>(resource, participant, std::move(config), device)) {
+  Impl& n = *impl_;
+  n.describe = std::move(describe);
+  dds::QosSettings qos;
+  qos.liveliness_lease_s = n.config.liveliness_lease_s;
+  n.capabilities = std::make_unique<dds::Writer<cell::Capability, cell::CapabilityPubSubType>>(
+      participant, "cell/capabilities", TopicKind::state, qos);
+
+  // Commands and their life cycle.
+  const std::string dev = device.name();
+  resource.add(std::make_unique<fb::CommandLifecycle>("lifecycle", n.config.when_busy));
+  n.subscribe<cell::Command, cell::CommandPubSubType>("commands", "cell/commands", TopicKind::events,
+                                                     [](const cell::Command& c) { return dds::to_data(c); });
+  resource.connect("commands", "IND", dev, "COMMAND");
+  resource.connect(dev, "ACCEPT", "lifecycle", "COMMAND");
+  resource.connect("lifecycle", "START", dev, "START");
+  for (const char* e : {"PROGRESS", "DONE", "FAIL"}) resource.connect(dev, e, "lifecycle", e);
+  for (const auto& [output, state] : kLifecycleOutputs) {
+    const std::string name = std::string("event_") + output;
+    const cell::CommandState s = state;
+    n.publish<cell::CommandEvent, cell::CommandEventPubSubType>(
+        name, "cell/command_events", [&n, s](const fb::Data& d) { return n.event_of(s, d); });
+    resource.connect("lifecycle", output, name, "REQ");
+  }
+
+  // The contract net.
+  n.contractor = &resource.add(std::make_unique<fb::Contractor>("contractor", n.config.id, n.config.exclusive,
+                                                                std::move(can_serve)));
+  n.subscribe<cell::CallForProposals, cell::CallForProposalsPubSubType>(
+      "calls", "cell/negotiation/calls", TopicKind::events, [](const cell::CallForProposals& c) {
+        return fb::Data{{"call_id", c.call_id()}, {"order_id", c.order_id()}, {"operation", c.operation()},
+                        {"part_type", c.part_type()}};
+      });
+  n.subscribe<cell::Award, cell::AwardPubSubType>("awards", "cell/negotiation/awards", TopicKind::events,
+                                                  [](const cell::Award& a) {
+                                                    return fb::Data{{"call_id", a.call_id()},
+                                                                    {"resource_id", a.resource_id()},
+                                                                    {"order_id", a.order_id()}};
+                                                  });
+  n.subscribe<cell::Release, cell::ReleasePubSubType>("releases", "cell/negotiation/releases", TopicKind::events,
+                                                      [](const cell::Release& r) {
+                                                        return fb::Data{{"order_id", r.order_id()},
+                                                                        {"resource_id", r.resource_id()}};
+                                                      });
+  n.subscribe<cell::OrderStatus, cell::OrderStatusPubSubType>(
+      "orders", "cell/orders/status", TopicKind::state, [](const cell::OrderStatus& s) {
+        return fb::Data{{"order_id", s.order_id()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
+      });
+  resource.add(std::make_unique<OrderWatch>());
+  resource.connect("calls", "IND", "contractor", "CFP");
+  resource.connect("awards", "IND", "contractor", "AWARD");
+  resource.connect("releases", "IND", "contractor", "RELEASE");
+  resource.connect("orders", "IND", "order_watch", "STATUS");
+  resource.connect("orders", "GONE", "order_watch", "GONE");
+  resource.connect("order_watch", "ENDED", "contractor", "ORDER_ENDED");
+  const std::string id = n.config.id;
+  n.publish<cell::Proposal, cell::ProposalPubSubType>("proposals", "cell/negotiation/proposals",
+                                                      [id](const fb::Data& d) {
+                                                        cell::Proposal p;
+                                                        p.call_id(fb::get<std::string>(d, "call_id"));
+                                                        p.resource_id(id);
+                                                        p.earliest_start(fb::get<double>(d, "earliest_start"));
+                                                        p.duration(fb::get<double>(d, "duration"));
+                                                        return p;
+                                                      });
+  n.publish<cell::AwardReply, cell::AwardReplyPubSubType>("award_replies", "cell/negotiation/replies",
+                                                          [id](const fb::Data& d) {
+                                                            cell::AwardReply r;
+                                                            r.call_id(fb::get<std::string>(d, "call_id"));
+                                                            r.resource_id(id);
+                                                            r.confirmed(fb::get<bool>(d, "confirmed"));
+                                                            r.reason(fb::get<std::string>(d, "reason"));
+                                                            return r;
+                                                          });
+  resource.connect("contractor", "PROPOSE", "proposals", "REQ");
+  resource.connect("contractor", "REPLY", "award_replies", "REQ");
+  resource.add(std::make_unique<fb::ActionBlock>("capability", [this](const fb::Data&) { publish_capability(); }));
+  resource.connect("contractor", "RESERVED", "capability", "REQ");
+  if (device.has_output("CAPABILITY")) resource.connect(dev, "CAPABILITY", "capability", "REQ");
+
+  // cell-sim, for devices that move things.
+  if (device.has_output("SIM")) {
+    n.publish<cell::SimRequest, cell::SimRequestPubSubType>("sim_requests", "cell/sim/requests",
+                                                            [](const fb::Data& d) { return dds::to_sim_request(d); });
+    n.sim_requests = &dynamic_cast<Pub<cell::SimRequest, cell::SimRequestPubSubType>&>(resource.block("sim_requests"));
+    n.subscribe<cell::SimReply, cell::SimReplyPubSubType>("sim_replies", "cell/sim/replies", TopicKind::events,
+                                                          [](const cell::SimReply& r) { return dds::to_data(r); });
+    resource.connect(dev, "SIM", "sim_requests", "REQ");
+    resource.connect("sim_replies", "IND", dev, "SIM_REPLY");
+  }
+}
+
+ResourceNode::~ResourceNode() = default;
+
+void ResourceNode::start(std::chrono::milliseconds wait_for_sim) {
+  // Requests are events, lost if nobody listens yet: a device that moves things needs cell-sim.
+  if (impl_->sim_requests && !impl_->sim_requests->writer().wait_for_readers(1, wait_for_sim)) {
+    throw std::runtime_error("cell-sim did not appear within " + std::to_string(wait_for_sim.count() / 1000) +
+                             " s on this domain");
+  }
+  publish_capability();
+  for (auto& start : impl_->starters) start();
+}
+
+dds::SimClock& ResourceNode::clock() { return impl_->clock; }
+
+void ResourceNode::publish_capability() {
+  const Impl& n = *impl_;
+  cell::Capability c;
+  c.resource_id(n.config.id);
+  c.kind(n.config.kind);
+  c.operations(std::vector<std::string>(n.device.operations().begin(), n.device.operations().end()));
+  c.position(dds::vec3(n.config.position[0], n.config.position[1], n.config.position[2]));
+  c.dock(dds::vec3(n.config.dock[0], n.config.dock[1], n.config.dock[2]));
+  c.reach(n.config.reach);
+  c.speed(n.config.speed);
+  c.angular_speed(n.config.angular_speed);
+  c.reserved_by(n.contractor->reserved_by());
+  if (n.describe) n.describe(c);
+  n.capabilities->write(c);
+}
+
+}  // namespace services

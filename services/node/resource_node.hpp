@@ -1,0 +1,66 @@
+#pragma once
+// What every resource process has around its device block, wired as function blocks on the
+// device's resource: the command topic into the device, the command life cycle, command
+// events out (stamped with sim time), the contract net (calls, proposals, awards, releases,
+// the end of orders) through a Contractor, the capability with its liveliness lease, and
+// cell-sim requests and replies when the device moves things.
+//
+//   cell/commands --> device.COMMAND --> lifecycle --> cell/command_events
+//   cell/negotiation/* and cell/orders/status --> contractor --> proposals, replies, capability
+//   device.SIM --> cell/sim/requests;  cell/sim/replies --> device.SIM_REPLY
+//   device.CAPABILITY --> cell/capabilities (e.g. a buffer's stock changed)
+//
+// A device block is any DeviceBlock; the node adds no product knowledge.
+
+#include <array>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "capabilities.h"
+#include "services/blocks/command_lifecycle.hpp"
+#include "services/blocks/contractor.hpp"
+#include "services/dds/participant.hpp"
+#include "services/dds/sim_clock.hpp"
+#include "services/node/device_block.hpp"
+#include "services/runtime/resource.hpp"
+
+namespace services {
+
+struct NodeConfig {
+  std::string id;
+  std::string kind;  // "station", "arm", "mobile-robot", "buffer"
+  std::array<double, 3> position{0, 0, 0};
+  std::array<double, 3> dock{0, 0, 0};
+  double speed = 0;          // m/s
+  double angular_speed = 0;  // rad/s
+  double reach = 0;          // m
+  bool exclusive = true;     // reserved by one order at a time
+  double liveliness_lease_s = 2.0;
+  fb::CommandLifecycle::WhenBusy when_busy = fb::CommandLifecycle::WhenBusy::reject;
+};
+
+class ResourceNode {
+ public:
+  // `device` must already be on `resource`. `can_serve` decides which calls for proposals
+  // it answers; `describe` adds to the capability what only the device knows (a stock).
+  ResourceNode(fb::Resource& resource, dds::ParticipantPtr participant, NodeConfig config, fb::DeviceBlock& device,
+               fb::Contractor::CanServe can_serve,
+               std::function<void(cell::Capability&)> describe = {});
+  ~ResourceNode();
+
+  // Starts listening to the topics; call once everything is wired. A device that moves
+  // things first waits for cell-sim; throws std::runtime_error if it does not come.
+  void start(std::chrono::milliseconds wait_for_sim = std::chrono::seconds(30));
+  dds::SimClock& clock();
+  void publish_capability();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace services

@@ -1,0 +1,24 @@
+#pragma once
+// Runs resources until a flag (set by a signal handler) turns false: each resource on a thread
+// of its own, delivering its events one at a time.
+
+#include <chrono>
+#include <csignal>
+#include <thread>
+#include <vector>
+
+#include "services/runtime/resource.hpp"
+
+namespace services {
+
+inline void run_until_stopped(const std::vector<fb::Resource*>& resources, const volatile std::sig_atomic_t& running) {
+  std::vector<std::thread> threads;
+  for (fb::Resource* r : resources) {
+    threads.emplace_back([r, &running] {
+      while (running) r->wait_and_run_one(std::chrono::milliseconds(100));
+    });
+  }
+  for (auto& t : threads) t.join();
+}
+
+}  // namespace services

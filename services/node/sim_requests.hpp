@@ -1,0 +1,42 @@
+#pragma once
+// Building cell-sim requests as event data, for device blocks that move things. Each request
+// gets an id of its requester's, so the device knows its reply among everyone's.
+
+#include <string>
+#include <vector>
+
+#include "services/runtime/event.hpp"
+
+namespace fb {
+
+class SimRequests {
+ public:
+  explicit SimRequests(std::string requester) : requester_(std::move(requester)) {}
+
+  Data spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents, bool is_static,
+             const std::string& mesh_uri = "");
+  Data remove(const std::string& body);
+  Data set_static(const std::string& body, bool is_static);
+  Data move(const std::string& body, const std::vector<std::string>& carried, const Numbers& path, double speed,
+            double angular_speed);
+
+  // Whether a SIM_REPLY answers the last request made.
+  bool answers_last(const Data& reply) const;
+  const std::string& last() const { return last_; }
+
+ private:
+  Data request(const std::string& kind, const std::string& body);
+  std::string requester_;
+  std::string last_;
+  std::size_t count_ = 0;
+};
+
+}  // namespace fb
+
+namespace fb {
+
+// A move's reply as what a device reports: DONE data (sim_time, distance, duration), or, in
+// `failure`, why it failed ("collision of arm-1/pad with B6, 1.2 mm deep").
+Data move_outcome(const Data& reply, std::string& failure);
+
+}  // namespace fb

@@ -1,0 +1,110 @@
+#include "services/station/arm_block.hpp"
+
+#include <cmath>
+
+namespace fb {
+
+ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
+    : DeviceBlock(std::move(name), id, {"grip", "translate", "rotate", "release", "connect", "disconnect"}),
+      settings_(settings), sim_(id) {
+  declare_input("SIM_REPLY", {"request_id", "ok"});
+  declare_output("SIM", {"request_id", "kind", "body_id"});
+
+  const auto op = [](const char* name) {
+    return [name](const Data& d) { return get<std::string>(d, "operation") == name; };
+  };
+  const auto mine = [this](const Data& d) {
+    return get<std::string>(d, "request_id").rfind(resource_id() + "/sim/", 0) == 0;
+  };
+
+  const auto is_grasp = [](const Data& d) {
+    return get<Numbers>(d, "path").size() == 7 && get<Numbers>(d, "size").size() == 3 &&
+           get<Numbers>(d, "direction").size() == 3;
+  };
+  transition("READY", "START", "WAITING", [this](const Data& d) { grip(d); },
+             [op, is_grasp](const Data& d) { return op("grip")(d) && is_grasp(d); });
+  transition("READY", "START", "READY", [this](const Data&) {
+    emit("FAIL", {{"reason", std::string("grip needs one pad pose, a pad size and a push direction")}});
+  }, op("grip"));
+  for (const char* motion : {"translate", "rotate"}) {
+    transition("READY", "START", "MOVING", [this](const Data& d) {
+      std::vector<std::string> carried{carriage()};
+      if (!held_.empty()) carried.push_back(held_);
+      emit("PROGRESS", {{"progress", 0.0}});
+      awaited_ = 1;
+      request(sim_.move(pad(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
+    }, op(motion));
+  }
+  transition("READY", "START", "READY", [this](const Data&) {
+    held_.clear();
+    emit("DONE");
+  }, op("release"));
+  for (const char* joining : {"connect", "disconnect"}) {
+    const bool is_static = std::string(joining) == "connect";
+    transition("READY", "START", "WAITING", [this, is_static](const Data& d) {
+      error_.clear();
+      awaited_ = 1;
+      request(sim_.set_static(get<std::string>(d, "part"), is_static));
+    }, op(joining));
+  }
+  // A motion ends with cell-sim's reply: where it stopped and why.
+  transition("MOVING", "SIM_REPLY", "READY", [this](const Data& reply) {
+    std::string failure;
+    Data outcome = move_outcome(reply, failure);
+    emit(failure.empty() ? "DONE" : "FAIL", std::move(outcome));
+  }, [this](const Data& d) { return sim_.answers_last(d); });
+  // Other commands end when all their requests are answered.
+  const auto note_error = [this](const Data& reply) {
+    if (!get<bool>(reply, "ok") && error_.empty()) error_ = get<std::string>(reply, "error");
+  };
+  transition("WAITING", "SIM_REPLY", "READY", [this, note_error](const Data& reply) {
+    note_error(reply);
+    awaited_ = 0;
+    if (error_.empty()) return emit("DONE");
+    emit("FAIL", {{"reason", error_}});
+  }, [this, mine](const Data& d) { return mine(d) && awaited_ == 1; });
+  transition("WAITING", "SIM_REPLY", "WAITING", [this, note_error](const Data& reply) {
+    note_error(reply);
+    --awaited_;
+  }, mine);
+}
+
+void ArmBlock::request(Data data) { emit("SIM", std::move(data)); }
+
+void ArmBlock::grip(const Data& d) {
+  error_.clear();
+  const Numbers& pose = get<Numbers>(d, "path");
+  const Numbers& size = get<Numbers>(d, "size");
+  const Numbers& push = get<Numbers>(d, "direction");
+  // The carriage runs behind the pad, against the push, along its main axis.
+  int axis = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (std::abs(push[i]) > std::abs(push[axis])) axis = i;
+  }
+  const double sign = push[axis] > 0 ? 1.0 : -1.0;
+  Numbers carriage_half(3, settings_.carriage_width / 2);
+  carriage_half[axis] = settings_.carriage_length / 2;
+  Numbers offset{0, 0, 0};
+  offset[axis] = -sign * (size[axis] + settings_.carriage_length / 2);
+  // The offset is in the pad's frame: turn it by the pad's orientation.
+  const double w = pose[3], x = pose[4], y = pose[5], z = pose[6];
+  const double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                          {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                          {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+  Numbers carriage_pose = pose;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) carriage_pose[r] += R[r][c] * offset[c];
+  }
+  awaited_ = 2;
+  if (has_gripper_) {
+    awaited_ += 2;
+    request(sim_.remove(pad()));
+    request(sim_.remove(carriage()));
+  }
+  request(sim_.spawn(pad(), pose, size, false));
+  request(sim_.spawn(carriage(), carriage_pose, carriage_half, false));
+  has_gripper_ = true;
+  held_ = get<std::string>(d, "part");
+}
+
+}  // namespace fb

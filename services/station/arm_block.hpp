@@ -1,0 +1,46 @@
+#pragma once
+// The station's robot arm: a gripper pad on a carriage, moved in cell-sim. It knows no
+// products: a part is a body id, a grasp is the pad's pose and size given by the command.
+//
+//   START grip (part, path = [pad pose], size = pad half extents, direction = push):
+//         the pad and its carriage (behind the pad, against the push) go to the grasp; the
+//         part is held from now on
+//   START translate | rotate (path): the pad moves along the path with the carriage and the
+//         held part; a collision ends it (FAIL with the contact)
+//   START release: lets go;  connect | disconnect (part): the part becomes an obstacle
+//         (joined to the assembly) or movable again
+//   SIM_REPLY: cell-sim's answers; SIM: requests to cell-sim
+
+#include "services/node/device_block.hpp"
+#include "services/node/sim_requests.hpp"
+
+namespace fb {
+
+struct ArmSettings {
+  double speed = 0.25;          // m/s
+  double angular_speed = 1.0;   // rad/s
+  double carriage_width = 0.020;
+  double carriage_length = 0.150;
+};
+
+class ArmBlock : public DeviceBlock {
+ public:
+  ArmBlock(std::string name, std::string resource_id, ArmSettings settings);
+
+  const std::string& held() const { return held_; }
+
+ private:
+  void grip(const Data& command);
+  std::string pad() const { return resource_id() + "/pad"; }
+  std::string carriage() const { return resource_id() + "/carriage"; }
+  void request(Data data);
+
+  ArmSettings settings_;
+  SimRequests sim_;
+  std::string held_;
+  bool has_gripper_ = false;
+  int awaited_ = 0;  // replies still to come for the current command
+  std::string error_;
+};
+
+}  // namespace fb

@@ -1,0 +1,67 @@
+// station: the assembly station and its robot arm, two resources of one process, each with
+// its own capability and event queue. The station is the place an order reserves; the arm
+// grips, moves, releases, connects and disconnects parts in cell-sim.
+//   station --domain 42 --id station-1 --arm-id arm-1 --position 0 0 0 --dock 0.6 0 0
+
+#include <csignal>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "services/node/resource_node.hpp"
+#include "services/node/run.hpp"
+#include "services/station/arm_block.hpp"
+#include "services/station/station_block.hpp"
+
+namespace {
+volatile std::sig_atomic_t running = 1;
+void stop(int) { running = 0; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"station: the assembly station and its robot arm"};
+  dds::ParticipantSettings dds;
+  services::NodeConfig station{"station-1", "station"}, arm{"arm-1", "arm"};
+  std::array<double, 3> table{1.0, 0.025, 1.0};
+  fb::ArmSettings arm_settings;
+  app.add_option("--domain", dds.domain_id, "DDS domain id")->required();
+  app.add_option("--id", station.id, "Resource id of the station");
+  app.add_option("--arm-id", arm.id, "Resource id of its arm");
+  app.add_option("--position", station.position, "The assembly point on the table's top: x y z, m");
+  app.add_option("--dock", station.dock, "Where parts are delivered: x y z, m");
+  app.add_option("--table", table, "Half extents of the table, m");
+  app.add_option("--arm-speed", arm_settings.speed, "m/s")->check(CLI::PositiveNumber);
+  app.add_option("--arm-angular-speed", arm_settings.angular_speed, "rad/s")->check(CLI::PositiveNumber);
+  app.add_option("--lease", station.liveliness_lease_s, "Liveliness lease of the capabilities, s");
+  CLI11_PARSE(app, argc, argv);
+  arm.position = station.position;
+  arm.dock = station.dock;
+  arm.speed = arm_settings.speed;
+  arm.angular_speed = arm_settings.angular_speed;
+  arm.liveliness_lease_s = station.liveliness_lease_s;
+  std::signal(SIGINT, stop);
+  std::signal(SIGTERM, stop);
+  try {
+    auto participant = dds::make_participant(station.id, dds);
+    fb::Resource station_resource(station.id, 256), arm_resource(arm.id, 256);
+    auto& station_block = station_resource.add(std::make_unique<fb::StationBlock>(
+        "station", station.id, fb::Numbers(station.position.begin(), station.position.end()),
+        fb::Numbers(table.begin(), table.end())));
+    auto& arm_block = arm_resource.add(std::make_unique<fb::ArmBlock>("arm", arm.id, arm_settings));
+    services::ResourceNode station_node(station_resource, participant, station, station_block,
+                                        [](const std::string& op, const std::string&) { return op == "host"; });
+    services::ResourceNode arm_node(arm_resource, participant, arm, arm_block, [&](const std::string& op, const std::string&) {
+      return arm_block.operations().count(op) > 0;
+    });
+    station_node.start();
+    arm_node.start();
+    station_resource.post("station", "INIT");
+    std::cout << "station " << station.id << " with arm " << arm.id << " ready on domain " << dds.domain_id
+              << std::endl;
+    services::run_until_stopped({&station_resource, &arm_resource}, running);
+  } catch (const std::exception& e) {
+    std::cerr << "error: station " << station.id << ": " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

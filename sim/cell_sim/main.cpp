@@ -1,0 +1,61 @@
+// cell-sim: the cell's one shared Bullet world, served over DDS. Requests on
+// cell/sim/requests (spawn, remove, set_static, set_movable, move) are answered on
+// cell/sim/replies; moves take simulated time from their speeds and end at the first
+// collision. The sim clock goes out on cell/clock.
+//   cell-sim --domain 42 --real-time-factor 20
+
+#include <csignal>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "services/dds/conversions.hpp"
+#include "services/dds/service_blocks.hpp"
+#include "sim/cell_sim/world_block.hpp"
+#include "simulationPubSubTypes.h"
+
+namespace {
+volatile std::sig_atomic_t running = 1;
+void stop(int) { running = 0; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"cell-sim: the shared simulation of the assembly cell"};
+  dds::ParticipantSettings settings;
+  double factor = 1.0;
+  app.add_option("--domain", settings.domain_id, "DDS domain id")->required();
+  app.add_option("--real-time-factor", factor, "Sim seconds per wall second")->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGINT, stop);
+  std::signal(SIGTERM, stop);
+  try {
+    auto participant = dds::make_participant("cell-sim", settings);
+    fb::Resource resource("cell-sim", 1024);
+    resource.add(std::make_unique<sim::WorldBlock>("world", factor));
+    auto& requests = resource.add(std::make_unique<dds::SubscribeBlock<cell::SimRequest, cell::SimRequestPubSubType>>(
+        "requests", participant, "cell/sim/requests", dds::TopicKind::events,
+        [](const cell::SimRequest& r) { return dds::to_data(r); }));
+    resource.add(std::make_unique<dds::PublishBlock<cell::SimReply, cell::SimReplyPubSubType>>(
+        "replies", participant, "cell/sim/replies", dds::TopicKind::events,
+        [](const fb::Data& d) { return dds::to_sim_reply(d); }));
+    resource.add(std::make_unique<dds::PublishBlock<cell::Clock, cell::ClockPubSubType>>(
+        "clock", participant, "cell/clock", dds::TopicKind::state, [](const fb::Data& d) {
+          cell::Clock c;
+          c.sim_time(fb::get<double>(d, "sim_time"));
+          c.real_time_factor(fb::get<double>(d, "real_time_factor"));
+          return c;
+        }));
+    resource.connect("requests", "IND", "world", "REQUEST");
+    resource.connect("world", "REPLY", "replies", "REQ");
+    resource.connect("world", "CLOCK", "clock", "REQ");
+    requests.start();
+    std::cout << "cell-sim ready on domain " << settings.domain_id << ", real-time factor " << factor << std::endl;
+    while (running) {
+      if (!resource.wait_and_run_one(std::chrono::milliseconds(1))) resource.post("world", "TICK");
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "error: cell-sim: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,104 @@
+#include "sim/cell_sim/world_block.hpp"
+
+#include <stdexcept>
+
+namespace sim {
+namespace {
+
+Pose pose_at(const fb::Numbers& n, std::size_t first) {
+  Pose p = Pose::Identity();
+  p.translation() = Eigen::Vector3d(n[first], n[first + 1], n[first + 2]);
+  p.linear() = Eigen::Quaterniond(n[first + 3], n[first + 4], n[first + 5], n[first + 6]).normalized().toRotationMatrix();
+  return p;
+}
+
+std::vector<Pose> poses(const fb::Numbers& n) {
+  if (n.size() % 7 != 0) throw SimError("a path needs seven numbers per pose");
+  std::vector<Pose> out;
+  for (std::size_t i = 0; i < n.size(); i += 7) out.push_back(pose_at(n, i));
+  return out;
+}
+
+std::vector<std::string> names(const std::string& joined) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start < joined.size()) {
+    const std::size_t comma = std::min(joined.find(',', start), joined.size());
+    if (comma > start) out.push_back(joined.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+WorldBlock::WorldBlock(std::string name, double real_time_factor, double clock_period_s)
+    : FunctionBlock(std::move(name)), factor_(real_time_factor), clock_period_(clock_period_s) {
+  if (real_time_factor <= 0) throw std::invalid_argument("the real-time factor must be above 0");
+  declare_input("REQUEST", {"request_id", "requester", "kind", "body_id"});
+  declare_input("TICK");
+  declare_output("REPLY", {"request_id", "requester", "ok", "error", "collided", "start_time", "end_time"});
+  declare_output("CLOCK", {"sim_time", "real_time_factor"});
+}
+
+double WorldBlock::now() const {
+  return factor_ * std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+}
+
+void WorldBlock::receive(const fb::Event& event) {
+  if (event.name == "REQUEST") handle(event.data);
+  publish_due();
+}
+
+void WorldBlock::handle(const fb::Data& d) {
+  const double start = now();
+  fb::Data reply{{"request_id", d.at("request_id")}, {"requester", d.at("requester")}, {"ok", true},
+                 {"start_time", start}, {"end_time", start}};
+  double due = start;
+  try {
+    const std::string& kind = fb::get<std::string>(d, "kind");
+    const std::string& id = fb::get<std::string>(d, "body_id");
+    if (kind == "spawn") {
+      const fb::Numbers& h = fb::get<fb::Numbers>(d, "half_extents");
+      world_.spawn({id, fb::get<std::string>(d, "mesh_uri"), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
+                    pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get<bool>(d, "is_static")});
+    } else if (kind == "remove") {
+      world_.remove(id);
+    } else if (kind == "set_static" || kind == "set_movable") {
+      world_.set_static(id, kind == "set_static");
+    } else if (kind == "move") {
+      const MoveResult r = world_.move({id, names(fb::get<std::string>(d, "carried")),
+                                        poses(fb::get<fb::Numbers>(d, "path")), fb::get<double>(d, "speed"),
+                                        fb::get<double>(d, "angular_speed")});
+      due = start + r.duration;
+      reply["end_time"] = due;
+      reply["distance"] = r.distance;
+      reply["collided"] = r.collided;
+      reply["hit_body"] = r.hit_body;
+      reply["hit_member"] = r.hit_member;
+      reply["depth"] = r.depth;
+    } else {
+      throw SimError("unknown request kind '" + kind + "'");
+    }
+  } catch (const std::exception& e) {  // a bad request fails alone; the world goes on
+    reply["ok"] = false;
+    reply["error"] = std::string(e.what());
+  }
+  pending_.emplace(due, std::move(reply));
+}
+
+void WorldBlock::publish_due() {
+  const double t = now();
+  while (!pending_.empty() && pending_.begin()->first <= t) {
+    fb::Data reply = std::move(pending_.begin()->second);
+    pending_.erase(pending_.begin());
+    emit("REPLY", std::move(reply));
+  }
+  const auto wall = std::chrono::steady_clock::now();
+  if (wall - last_clock_ >= clock_period_) {
+    last_clock_ = wall;
+    emit("CLOCK", {{"sim_time", t}, {"real_time_factor", factor_}});
+  }
+}
+
+}  // namespace sim

@@ -1,0 +1,38 @@
+#pragma once
+// cell-sim's function block: requests change the world at once and are answered at once;
+// a move is answered when the sim clock reaches its end (or its first collision). TICK
+// (from the process's loop) advances the clock and publishes what is due.
+//
+//   inputs                          outputs
+//   REQUEST (SimRequest fields)     REPLY (SimReply fields)
+//   TICK                            CLOCK (sim_time, real_time_factor), every clock_period
+
+#include <chrono>
+#include <map>
+
+#include "services/runtime/function_block.hpp"
+#include "sim/world/sim_world.hpp"
+
+namespace sim {
+
+class WorldBlock : public fb::FunctionBlock {
+ public:
+  WorldBlock(std::string name, double real_time_factor, double clock_period_s = 0.05);
+
+  double now() const;  // sim s
+  const SimWorld& world() const { return world_; }
+  void receive(const fb::Event& event) override;
+
+ private:
+  void handle(const fb::Data& request);
+  void publish_due();
+
+  SimWorld world_;
+  double factor_;
+  std::chrono::duration<double> clock_period_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_clock_{};
+  std::multimap<double, fb::Data> pending_;  // replies by the sim time they are due
+};
+
+}  // namespace sim

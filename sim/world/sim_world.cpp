@@ -1,0 +1,124 @@
+#include "sim/world/sim_world.hpp"
+
+#include <algorithm>
+
+namespace sim {
+namespace {
+
+Pose interpolate(const Pose& from, const Pose& to, double s) {
+  Pose pose = Pose::Identity();
+  pose.linear() = Eigen::Quaterniond(from.linear()).slerp(s, Eigen::Quaterniond(to.linear())).toRotationMatrix();
+  pose.translation() = (1 - s) * from.translation() + s * to.translation();
+  return pose;
+}
+
+}  // namespace
+
+SimWorld::SimWorld(CollisionOptions options) : world_(options) {}
+
+SimWorld::Body& SimWorld::body(const std::string& id) {
+  const auto it = bodies_.find(id);
+  if (it == bodies_.end()) throw SimError("no body " + id);
+  return it->second;
+}
+
+void SimWorld::spawn(const BodySpec& spec) {
+  if (spec.id.empty()) throw SimError("a body needs an id");
+  if (bodies_.count(spec.id)) throw SimError("body " + spec.id + " exists already");
+  Body body{spec, nullptr, std::nullopt};
+  if (!spec.mesh_uri.empty()) {
+    try {
+      body.mesh = meshes_.get(spec.mesh_uri);
+    } catch (const MeshError& e) {
+      throw SimError("body " + spec.id + ": " + e.what());
+    }
+  }
+  if (spec.is_static) add_obstacle(body);
+  bodies_.emplace(spec.id, std::move(body));
+}
+
+void SimWorld::add_obstacle(Body& body) {
+  if (body.mesh) {
+    body.obstacle = world_.add_static_mesh(body.spec.id, body.mesh, body.spec.pose);
+  } else if (!body.spec.half_extents.isZero()) {
+    body.obstacle = world_.add_static_box(body.spec.id, body.spec.half_extents, body.spec.pose);
+  }
+}
+
+void SimWorld::remove(const std::string& id) {
+  Body& b = body(id);
+  if (b.obstacle) world_.remove(*b.obstacle);
+  bodies_.erase(id);
+}
+
+void SimWorld::set_static(const std::string& id, bool is_static) {
+  Body& b = body(id);
+  if (b.spec.is_static == is_static) return;
+  b.spec.is_static = is_static;
+  if (is_static) {
+    add_obstacle(b);
+  } else if (b.obstacle) {
+    world_.remove(*b.obstacle);
+    b.obstacle.reset();
+  }
+}
+
+MoveResult SimWorld::move(const MoveRequest& request) {
+  if (request.speed <= 0) throw SimError("a move of " + request.body + " needs a speed above 0");
+  std::vector<Body*> moving{&body(request.body)};
+  for (const auto& id : request.carried) moving.push_back(&body(id));
+  for (const Body* b : moving) {
+    if (b->spec.is_static) throw SimError("body " + b->spec.id + " is static: set it movable before moving it");
+  }
+  // One compound in the frame of the moving body, each member at its offset now.
+  const Pose start = moving.front()->spec.pose;
+  MovingBody compound;
+  const double margin = world_.options().shape_margin;
+  std::vector<Pose> offsets;
+  for (const Body* b : moving) {
+    const Pose offset = offsets.emplace_back(start.inverse() * b->spec.pose);
+    if (b->mesh) {
+      compound.add_mesh(b->spec.id, *b->mesh, offset, margin);
+    } else if (!b->spec.half_extents.isZero()) {
+      compound.add_box(b->spec.id, b->spec.half_extents, offset, margin);
+    }
+  }
+
+  MoveResult result;
+  Pose at = start;
+  for (const Pose& next : request.path) {
+    const double length = (next.translation() - at.translation()).norm();
+    const double angle = Eigen::Quaterniond(at.linear()).angularDistance(Eigen::Quaterniond(next.linear()));
+    const double duration =
+        std::max(length / request.speed, request.angular_speed > 0 ? angle / request.angular_speed : 0.0);
+    std::optional<Contact> contact;
+    if (!compound.empty()) contact = world_.sweep(compound, at, next);
+    const double done = contact ? contact->fraction : 1.0;
+    result.distance += done * length;
+    result.duration += done * duration;
+    const Pose reached = interpolate(at, next, done);
+    if (contact) {
+      result.collided = true;
+      result.hit_body = contact->body_name;
+      result.hit_member = contact->member;
+      result.depth = contact->depth;
+    }
+    at = reached;
+    if (contact) break;
+  }
+  for (std::size_t i = 0; i < moving.size(); ++i) moving[i]->spec.pose = at * offsets[i];
+  return result;
+}
+
+std::optional<Pose> SimWorld::pose(const std::string& id) const {
+  const auto it = bodies_.find(id);
+  if (it == bodies_.end()) return std::nullopt;
+  return it->second.spec.pose;
+}
+
+bool SimWorld::is_static(const std::string& id) const {
+  const auto it = bodies_.find(id);
+  return it != bodies_.end() && it->second.spec.is_static;
+}
+
+}  // namespace sim

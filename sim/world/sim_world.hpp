@@ -1,0 +1,78 @@
+#pragma once
+// The cell's one shared world, as cell-sim keeps it: named bodies (parts, the station's
+// table, the gripper, the mobile robot) with shapes and poses, some of them static
+// obstacles, and motions of one body with the bodies it carries along a path, in simulated
+// time from speeds, stopped at the first collision with a static body. No DDS here: the
+// cell-sim process serves this over topics.
+
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sim/collision/collision_world.hpp"
+
+namespace sim {
+
+class SimError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct BodySpec {
+  std::string id;
+  std::string mesh_uri;                                         // a mesh file, or
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();       // a box; neither: no shape
+  Pose pose = Pose::Identity();
+  bool is_static = false;
+};
+
+struct MoveRequest {
+  std::string body;
+  std::vector<std::string> carried;  // keep their offsets to `body` while it moves
+  std::vector<Pose> path;            // poses of `body`, after its current one
+  double speed = 0;                  // m/s, > 0
+  double angular_speed = 0;          // rad/s; 0: turning takes no time
+};
+
+struct MoveResult {
+  bool collided = false;
+  std::string hit_body;    // the static body hit
+  std::string hit_member;  // which moving body hit it
+  double depth = 0;        // m
+  double duration = 0;     // sim s, until the end or the collision
+  double distance = 0;     // m travelled by `body`
+};
+
+class SimWorld {
+ public:
+  explicit SimWorld(CollisionOptions options = {});
+
+  // Each throws SimError with the reason: an id taken or unknown, a mesh that cannot be read,
+  // a move of a static body.
+  void spawn(const BodySpec& body);
+  void remove(const std::string& id);
+  void set_static(const std::string& id, bool is_static);
+  // Moves the bodies to the path's end, or to where they first collided.
+  MoveResult move(const MoveRequest& request);
+
+  std::optional<Pose> pose(const std::string& id) const;
+  bool is_static(const std::string& id) const;
+  std::size_t size() const { return bodies_.size(); }
+
+ private:
+  struct Body {
+    BodySpec spec;
+    std::shared_ptr<const TriangleMesh> mesh;
+    std::optional<BodyId> obstacle;  // in the collision world while static
+  };
+  Body& body(const std::string& id);
+  void add_obstacle(Body& body);
+
+  CollisionWorld world_;
+  MeshCache meshes_;
+  std::map<std::string, Body> bodies_;
+};
+
+}  // namespace sim

@@ -1,0 +1,61 @@
+#include "twin/report/plan_json.hpp"
+
+namespace twin {
+namespace {
+
+nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+nlohmann::json quat(const Pose& p) {
+  const Quat q(p.linear());
+  return {q.w(), q.x(), q.y(), q.z()};
+}
+
+}  // namespace
+
+nlohmann::json plan_json(const Product& product, const Plan& plan) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (std::size_t i = 0; i < plan.steps.size(); ++i) {
+    const auto& step = plan.steps[i];
+    const auto& part = product.parts()[step.part];
+    nlohmann::json trajectory = nlohmann::json::array();
+    for (const auto& w : step.trajectory.waypoints) {
+      trajectory.push_back({{"phase", w.phase},
+                            {"holding", w.holding},
+                            {"position", vec(w.part.translation())},
+                            {"orientation", quat(w.part)},
+                            {"gripper_position", vec(w.gripper.translation())}});
+    }
+    nlohmann::json failed = nlohmann::json::array();
+    for (const auto& a : step.failed) {
+      failed.push_back({{"label", a.trajectory.label},
+                        {"direction", vec(a.trajectory.direction)},
+                        {"hit", a.collision->with},
+                        {"by", a.collision->member},
+                        {"depth", a.collision->depth},
+                        {"phase", a.collision->phase}});
+    }
+    steps.push_back({{"step", i + 1},
+                     {"part", part.name},
+                     {"type", short_type_name(part.type)},
+                     {"label", step.trajectory.label},
+                     {"direction", vec(step.trajectory.direction)},
+                     {"path_length", step.trajectory.path_length()},
+                     {"tries", step.failed.size() + 1},
+                     {"failed_tries", failed},
+                     {"trajectory", trajectory}});
+  }
+  nlohmann::json findings = nlohmann::json::array();
+  for (const auto& f : plan.findings) findings.push_back({{"kind", f.kind}, {"message", f.message}, {"parts", f.parts}});
+  return {{"schema", "agile-cell/plan"},
+          {"version", 1},
+          {"product", product.name()},
+          {"source", product.source().string()},
+          {"complete", plan.complete},
+          {"sequence_planner", plan.sequence_planner},
+          {"path_planner", plan.path_planner},
+          {"backtracks", plan.backtracks},
+          {"units", {{"length", "m"}}},
+          {"steps", steps},
+          {"findings", findings}};
+}
+
+}  // namespace twin
