@@ -10,6 +10,8 @@
 
 namespace dds {
 
+constexpr std::uint32_t kMaxParticipantsPerHost = 32;
+
 ParticipantPtr make_participant(const std::string& name, const ParticipantSettings& settings) {
   using namespace eprosima::fastdds::dds;
   DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
@@ -19,6 +21,10 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
     qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
     udp->interfaceWhiteList.emplace_back("127.0.0.1");
+    // The initial peer 127.0.0.1 stands for the discovery ports of participants 0..N-1 on
+    // this host; Fast DDS's default N is 4, and a cell has more processes than that (the
+    // sixth one was never discovered). 32 covers a cell, its twins and cellctl.
+    udp->maxInitialPeersRange = kMaxParticipantsPerHost;
     qos.transport().user_transports.push_back(udp);
     eprosima::fastrtps::rtps::Locator_t peer;
     peer.kind = LOCATOR_KIND_UDPv4;

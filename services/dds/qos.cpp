@@ -8,6 +8,11 @@ using namespace eprosima::fastdds::dds;
 template <class Qos>
 void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
   qos.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  // Fast DDS's default is 10 instances per writer and reader: the eleventh cell-sim request
+  // (one instance per request id) was silently never delivered. 0 = unlimited in 2.9.
+  qos.resource_limits().max_instances = 0;
+  qos.resource_limits().max_samples_per_instance = 0;
+  qos.resource_limits().max_samples = 0;
   if (kind == TopicKind::state) {
     qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = KEEP_LAST_HISTORY_QOS;

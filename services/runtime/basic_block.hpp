@@ -27,6 +27,10 @@ class BasicBlock : public FunctionBlock {
   // Transitions are tried in the order they were added.
   void transition(std::string from, std::string event, std::string to, Action action = {}, Guard guard = {});
 
+  // For an action whose outcome decides where the chart goes (a failure in the middle of a
+  // script): enters `state` instead of the transition's own target.
+  void enter(std::string state) { state_ = std::move(state); }
+
  private:
   struct Transition {
     std::string from, event, to;

@@ -23,8 +23,10 @@ int main(int argc, char** argv) {
   CLI::App app{"cell-sim: the shared simulation of the assembly cell"};
   dds::ParticipantSettings settings;
   double factor = 1.0;
+  bool verbose = false;
   app.add_option("--domain", settings.domain_id, "DDS domain id")->required();
   app.add_option("--real-time-factor", factor, "Sim seconds per wall second")->check(CLI::PositiveNumber);
+  app.add_flag("--verbose", verbose, "Print every request and reply");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
@@ -34,10 +36,17 @@ int main(int argc, char** argv) {
     resource.add(std::make_unique<sim::WorldBlock>("world", factor));
     auto& requests = resource.add(std::make_unique<dds::SubscribeBlock<cell::SimRequest, cell::SimRequestPubSubType>>(
         "requests", participant, "cell/sim/requests", dds::TopicKind::events,
-        [](const cell::SimRequest& r) { return dds::to_data(r); }));
+        [verbose](const cell::SimRequest& r) {
+          if (verbose) std::cout << "request " << r.request_id() << " " << r.kind() << " " << r.body_id() << std::endl;
+          return dds::to_data(r);
+        }));
     resource.add(std::make_unique<dds::PublishBlock<cell::SimReply, cell::SimReplyPubSubType>>(
         "replies", participant, "cell/sim/replies", dds::TopicKind::events,
-        [](const fb::Data& d) { return dds::to_sim_reply(d); }));
+        [verbose](const fb::Data& d) {
+          cell::SimReply reply = dds::to_sim_reply(d);
+          if (verbose) std::cout << "reply " << reply.request_id() << (reply.ok() ? " ok " : " refused ") << reply.error() << std::endl;
+          return reply;
+        }));
     resource.add(std::make_unique<dds::PublishBlock<cell::Clock, cell::ClockPubSubType>>(
         "clock", participant, "cell/clock", dds::TopicKind::state, [](const fb::Data& d) {
           cell::Clock c;

@@ -63,6 +63,9 @@ class AssemblyScene {
   // The part held for a push along `direction`: the pad on the face behind it, the carriage
   // running away from the part.
   HeldPart hold(PartIndex part, const Vec3& direction) const;
+  // Half extents of the gripper pad for that push: as wide as the part's face, at most
+  // pad_max_width, pad_thickness along the push.
+  Eigen::Vector3d pad_half_extents(PartIndex part, const Vec3& direction) const;
   std::optional<Collision> collision_at(const sim::MovingBody& body, const Pose& pose, const std::string& phase) const;
 
   // Runs the trajectory in the collision world: the held part with the arm, then the arm
@@ -72,7 +75,6 @@ class AssemblyScene {
   const sim::CollisionWorld& world() const { return world_; }
 
  private:
-  Eigen::Vector3d pad_half_extents(PartIndex part, const Vec3& direction) const;
   Collision to_collision(const sim::Contact& contact, const std::string& phase) const;
 
   const LoadedProduct& product_;

@@ -1,0 +1,308 @@
+// twin: the digital twin of one order. Reads the product description, plans the assembly,
+// then orchestrates the cell over DDS (OrderOrchestrator): negotiation, virtual assembly in
+// cell-sim, physical assembly. Publishes its status while it lives (a twin that dies is
+// noticed by the resources it reserved) and writes the plan and the animation.
+//   twin --domain 42 --order o1 --product deploy/products/cranfield/cranfield.aml --out out/o1
+// Exit codes: 0 assembled, 1 the order failed, 2 bad input.
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+
+#include <CLI/CLI.hpp>
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "negotiationPubSubTypes.h"
+#include "ordersPubSubTypes.h"
+#include "services/blocks/action_block.hpp"
+#include "services/dds/conversions.hpp"
+#include "services/dds/service_blocks.hpp"
+#include "services/dds/sim_clock.hpp"
+#include "simulationPubSubTypes.h"
+#include "twin/geometry/product_loader.hpp"
+#include "twin/model/source_ref.hpp"
+#include "twin/orchestration/order_orchestrator.hpp"
+#include "twin/report/gltf_animation.hpp"
+#include "twin/report/plan_json.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t running = 1;
+void stop(int) { running = 0; }
+
+using dds::TopicKind;
+
+cell::OrderState order_state(const std::string& s) {
+  static const std::map<std::string, cell::OrderState> states = {
+      {"SUBMITTED", cell::SUBMITTED}, {"PLANNING", cell::PLANNING}, {"NEGOTIATING", cell::PLANNING},
+      {"VIRTUAL_ASSEMBLY", cell::VIRTUAL_ASSEMBLY}, {"PHYSICAL_ASSEMBLY", cell::PHYSICAL_ASSEMBLY},
+      {"DONE", cell::DONE}, {"FAILED", cell::FAILED}};
+  return states.at(s);
+}
+
+const char* state_name(cell::CommandState s) {
+  switch (s) {
+    case cell::ACCEPTED: return "accepted";
+    case cell::EXECUTING: return "executing";
+    case cell::CANCELING: return "canceling";
+    case cell::SUCCEEDED: return "succeeded";
+    case cell::CANCELED: return "canceled";
+    case cell::ABORTED: return "aborted";
+  }
+  return "unknown";
+}
+
+struct Options {
+  dds::ParticipantSettings dds;
+  std::string order, product, out = ".", sequence = "search", path = "linear";
+  double wait_s = 30, lease_s = 2;
+  bool verbose = false;
+};
+
+class TwinProcess {
+ public:
+  explicit TwinProcess(const Options& o)
+      : options_(o), participant_(dds::make_participant("twin-" + o.order, o.dds)), clock_(participant_) {
+    dds::QosSettings qos;
+    qos.liveliness_lease_s = o.lease_s;
+    status_ = std::make_unique<dds::Writer<cell::OrderStatus, cell::OrderStatusPubSubType>>(
+        participant_, "cell/orders/status", TopicKind::state, qos);
+    result_ = std::make_unique<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>>(
+        participant_, "cell/orders/result", TopicKind::state, qos);
+  }
+
+  void status(const std::string& state, const std::string& message, double progress) {
+    cell::OrderStatus s;
+    s.order_id(options_.order);
+    s.state(order_state(state));
+    s.message(message);
+    s.progress(progress);
+    s.sim_time(clock_.now());
+    status_->write(s);
+    std::cout << "[" << options_.order << "] " << state << ": " << message << std::endl;
+  }
+
+  void result(bool complete, const std::string& plan_file, const std::string& animation, const std::string& error) {
+    cell::OrderResult r;
+    r.order_id(options_.order);
+    r.complete(complete);
+    r.plan_file(plan_file);
+    r.animation_file(animation);
+    r.error(error);
+    result_->write(r);
+  }
+
+  // Plans, then orchestrates; returns the exit code.
+  int run() {
+    status("SUBMITTED", options_.product, 0);
+    sim::MeshCache meshes;
+    std::optional<twin::LoadedProduct> loaded;
+    try {
+      loaded.emplace(twin::load_product(options_.product, meshes));
+    } catch (const twin::DescriptionError& e) {
+      return end_with(2, std::string("bad product description: ") + e.what());
+    }
+    const twin::LoadedProduct& product = *loaded;
+    status("PLANNING", "planning " + std::to_string(product.product.parts().size()) + " parts", 0);
+    auto sequence = twin::make_sequence_planner(options_.sequence);
+    auto path = twin::make_path_planner(options_.path);
+    twin::Plan plan = twin::plan_assembly(product, *sequence, *path);
+    std::filesystem::create_directories(options_.out);
+    const auto plan_file = std::filesystem::absolute(options_.out) / "plan.json";
+    if (!plan.complete) {
+      write_plan(product, plan, plan_file);
+      std::string why = plan.findings.empty() ? "no complete plan" : plan.findings.back().message;
+      return end_with(1, "planning found no complete assembly: " + why, plan_file.string());
+    }
+    return orchestrate(product, plan, plan_file);
+  }
+
+ private:
+  // `reported`: the orchestrator has published FAILED already.
+  int end_with(int code, const std::string& error, const std::string& plan_file = "", bool reported = false) {
+    if (!reported) status("FAILED", error, 0);
+    result(false, plan_file, "", error);
+    std::cerr << "error: order " << options_.order << ": " << error << '\n';
+    linger();
+    return code;
+  }
+
+  // Gives the last samples time to reach the readers before the participant goes.
+  void linger() {
+    status_->wait_for_readers(1, std::chrono::milliseconds(500));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  }
+
+  static void write_plan(const twin::LoadedProduct& product, const twin::Plan& plan, const std::filesystem::path& file) {
+    std::ofstream(file) << twin::plan_json(product.product, plan).dump(2) << '\n';
+  }
+
+  template <class T, class P>
+  void subscribe(fb::Resource& r, const std::string& name, const std::string& topic, TopicKind kind,
+                 std::function<fb::Data(const T&)> to_data, const char* ind, const char* gone = nullptr) {
+    auto& block = r.add(std::make_unique<dds::SubscribeBlock<T, P>>(name, participant_, topic, kind, std::move(to_data)));
+    r.connect(name, "IND", "orchestrator", ind);
+    if (gone) r.connect(name, "GONE", "orchestrator", gone);
+    starters_.push_back([&block] { block.start(); });
+  }
+  template <class T, class P>
+  dds::PublishBlock<T, P>& publish(fb::Resource& r, const std::string& name, const std::string& topic, const char* output,
+                                   std::function<T(const fb::Data&)> to_sample) {
+    auto& block = r.add(std::make_unique<dds::PublishBlock<T, P>>(name, participant_, topic, TopicKind::events,
+                                                                  std::move(to_sample)));
+    r.connect("orchestrator", output, name, "REQ");
+    return block;
+  }
+
+  int orchestrate(const twin::LoadedProduct& product, twin::Plan& plan, const std::filesystem::path& plan_file) {
+    fb::Resource r("twin-" + options_.order, 4096);
+    twin::OrderSettings settings;
+    settings.order_id = options_.order;
+    settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
+    auto& orchestrator = r.add(std::make_unique<twin::OrderOrchestrator>("orchestrator", product, plan, settings));
+    const std::string order = options_.order;
+
+    subscribe<cell::Capability, cell::CapabilityPubSubType>(
+        r, "capabilities", "cell/capabilities", TopicKind::state, [](const cell::Capability& c) {
+          return fb::Data{{"resource_id", c.resource_id()}, {"dock", dds::to_numbers(c.dock())},
+                          {"position", dds::to_numbers(c.position())}};
+        }, "CAPABILITY", "RESOURCE_GONE");
+    subscribe<cell::Proposal, cell::ProposalPubSubType>(
+        r, "proposals", "cell/negotiation/proposals", TopicKind::events, [](const cell::Proposal& p) {
+          return fb::Data{{"call_id", p.call_id()}, {"resource_id", p.resource_id()}};
+        }, "PROPOSAL");
+    subscribe<cell::AwardReply, cell::AwardReplyPubSubType>(
+        r, "award_replies", "cell/negotiation/replies", TopicKind::events, [](const cell::AwardReply& a) {
+          return fb::Data{{"call_id", a.call_id()}, {"resource_id", a.resource_id()}, {"confirmed", a.confirmed()},
+                          {"reason", a.reason()}};
+        }, "AWARD_REPLY");
+    subscribe<cell::CommandEvent, cell::CommandEventPubSubType>(
+        r, "command_events", "cell/command_events", TopicKind::events, [this](const cell::CommandEvent& e) {
+          clock_.observe(e.sim_time());
+          if (options_.verbose) std::cout << "  event " << e.command_id() << " " << state_name(e.state()) << " " << e.reason() << std::endl;
+          return fb::Data{{"command_id", e.command_id()}, {"order_id", e.order_id()},
+                          {"resource_id", e.resource_id()}, {"state", std::string(state_name(e.state()))},
+                          {"reason", e.reason()}};
+        }, "COMMAND_EVENT");
+    subscribe<cell::SimReply, cell::SimReplyPubSubType>(
+        r, "sim_replies", "cell/sim/replies", TopicKind::events, [this](const cell::SimReply& s) {
+          clock_.observe(s.end_time());
+          if (options_.verbose) std::cout << "  sim reply " << s.request_id() << " " << s.ok() << " " << s.error() << std::endl;
+          return dds::to_data(s);
+        }, "SIM_REPLY");
+
+    publish<cell::CallForProposals, cell::CallForProposalsPubSubType>(
+        r, "calls", "cell/negotiation/calls", "CFP", [](const fb::Data& d) {
+          cell::CallForProposals c;
+          c.call_id(fb::get<std::string>(d, "call_id"));
+          c.order_id(fb::get<std::string>(d, "order_id"));
+          c.operation(fb::get<std::string>(d, "operation"));
+          c.part_type(fb::get<std::string>(d, "part_type"));
+          return c;
+        });
+    publish<cell::Award, cell::AwardPubSubType>(r, "awards", "cell/negotiation/awards", "AWARD", [](const fb::Data& d) {
+      cell::Award a;
+      a.call_id(fb::get<std::string>(d, "call_id"));
+      a.resource_id(fb::get<std::string>(d, "resource_id"));
+      a.order_id(fb::get<std::string>(d, "order_id"));
+      a.lease(fb::get<double>(d, "lease"));
+      return a;
+    });
+    publish<cell::Release, cell::ReleasePubSubType>(r, "releases", "cell/negotiation/releases", "RELEASE",
+                                                    [](const fb::Data& d) {
+                                                      cell::Release x;
+                                                      x.order_id(fb::get<std::string>(d, "order_id"));
+                                                      x.resource_id(fb::get<std::string>(d, "resource_id"));
+                                                      return x;
+                                                    });
+    publish<cell::Command, cell::CommandPubSubType>(r, "commands", "cell/commands", "COMMAND", [this](const fb::Data& d) {
+      cell::Command c = dds::to_command(d);
+      c.sim_time(clock_.now());
+      if (options_.verbose) std::cout << "  command " << c.command_id() << " to " << c.resource_id() << std::endl;
+      return c;
+    });
+    auto& sim = publish<cell::SimRequest, cell::SimRequestPubSubType>(
+        r, "sim_requests", "cell/sim/requests", "SIM", [this](const fb::Data& d) {
+          if (options_.verbose) std::cout << "  sim " << fb::get<std::string>(d, "request_id") << " "
+                                          << fb::get<std::string>(d, "kind") << " " << fb::get<std::string>(d, "body_id") << std::endl;
+          return dds::to_sim_request(d);
+        });
+    r.add(std::make_unique<fb::ActionBlock>("status", [this](const fb::Data& d) {
+      status(fb::get<std::string>(d, "state"), fb::get<std::string>(d, "message"), fb::get<double>(d, "progress"));
+    }));
+    r.connect("orchestrator", "STATUS", "status", "REQ");
+    r.add(std::make_unique<fb::ActionBlock>("findings", [&plan](const fb::Data& d) {
+      plan.findings.push_back({fb::get<std::string>(d, "kind"), fb::get<std::string>(d, "message"),
+                               {fb::get<std::string>(d, "part")}});
+      std::cout << "finding: " << fb::get<std::string>(d, "message") << std::endl;
+    }));
+    r.connect("orchestrator", "FINDING", "findings", "REQ");
+    bool finished = false;
+    r.add(std::make_unique<fb::ActionBlock>("finished", [&finished](const fb::Data&) { finished = true; }));
+    r.connect("orchestrator", "FINISHED", "finished", "REQ");
+
+    for (auto& start : starters_) start();
+    const auto wait = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
+    if (!sim.writer().wait_for_readers(1, wait)) {
+      return end_with(1, "cell-sim did not appear within " + std::to_string(static_cast<int>(options_.wait_s)) +
+                             " s: is the cell up on domain " + std::to_string(options_.dds.domain_id) + "?");
+    }
+    r.post("orchestrator", "START");
+    auto last_tick = std::chrono::steady_clock::now();
+    while (!finished && running) {
+      r.wait_and_run_one(std::chrono::milliseconds(50));
+      if (std::chrono::steady_clock::now() - last_tick > std::chrono::milliseconds(250)) {
+        last_tick = std::chrono::steady_clock::now();
+        r.post("orchestrator", "TICK");
+      }
+    }
+    if (!finished) return end_with(1, "stopped before the order ended");
+
+    // What the designer gets: the plan with virtual assembly's findings and the validated
+    // trajectories, and the animation of it.
+    for (std::size_t i = 0; i < orchestrator.validated().size(); ++i) plan.steps[i].trajectory = orchestrator.validated()[i];
+    write_plan(product, plan, plan_file);
+    const auto animation = plan_file.parent_path() / "animation.gltf";
+    twin::write_gltf_animation(product, plan, animation);
+    if (!orchestrator.error().empty()) return end_with(1, orchestrator.error(), plan_file.string(), true);
+    result(true, plan_file.string(), animation.string(), "");
+    linger();
+    return 0;
+  }
+
+  Options options_;
+  dds::ParticipantPtr participant_;
+  dds::SimClock clock_;
+  std::unique_ptr<dds::Writer<cell::OrderStatus, cell::OrderStatusPubSubType>> status_;
+  std::unique_ptr<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>> result_;
+  std::vector<std::function<void()>> starters_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"twin: the digital twin of one order"};
+  Options o;
+  app.add_option("--domain", o.dds.domain_id, "DDS domain id")->required();
+  app.add_option("--order", o.order, "Order id")->required();
+  app.add_option("--product", o.product, "The product's AutomationML file")->required();
+  app.add_option("--out", o.out, "Folder for plan.json and animation.gltf");
+  app.add_option("--sequence", o.sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
+  app.add_option("--path", o.path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
+  app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);
+  app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
+  app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGINT, stop);
+  std::signal(SIGTERM, stop);
+  try {
+    TwinProcess twin(o);
+    return twin.run();
+  } catch (const std::exception& e) {
+    std::cerr << "error: twin " << o.order << ": " << e.what() << '\n';
+    return 1;
+  }
+}
