@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "deploy/cellctl/cell_commands.hpp"
+#include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/describe_command.hpp"
 #include "deploy/cellctl/plan_command.hpp"
 #include "twin/model/source_ref.hpp"
@@ -15,12 +17,16 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   cellctl::add_describe_command(app, exit_code);
   cellctl::add_plan_command(app, exit_code);
+  cellctl::add_cell_commands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
+    return 2;
+  } catch (const cellctl::ConfigError& e) {
+    std::cerr << "error: " << e.what() << '\n';
     return 2;
   } catch (const twin::DescriptionError& e) {
     std::cerr << "error: " << e.what() << '\n';

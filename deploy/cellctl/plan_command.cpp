@@ -28,12 +28,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->callback([options, &exit_code] {
     sim::MeshCache meshes;
     const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
-    for (std::size_t i = 0; i < loaded.meshes.size(); ++i) {
-      if (!loaded.meshes[i]) {
-        const auto& part = loaded.product.parts()[i];
-        throw twin::DescriptionError(part.where, "part '" + part.name + "' has no geometry to plan with");
-      }
-    }
+    twin::require_geometry(loaded);
     auto sequence = twin::make_sequence_planner(options->sequence);
     auto path = twin::make_path_planner(options->path);
     const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path);

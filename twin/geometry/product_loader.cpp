@@ -33,4 +33,13 @@ LoadedProduct load_product(const std::filesystem::path& file, sim::MeshCache& ca
   return loaded;
 }
 
+void require_geometry(const LoadedProduct& loaded) {
+  for (std::size_t i = 0; i < loaded.meshes.size(); ++i) {
+    if (!loaded.meshes[i]) {
+      const auto& part = loaded.product.parts()[i];
+      throw DescriptionError(part.where, "part '" + part.name + "' has no geometry to plan with");
+    }
+  }
+}
+
 }  // namespace twin

@@ -19,6 +19,9 @@ struct LoadedProduct {
   PartMeshes meshes;
 };
 
+// Throws DescriptionError for the first part without a mesh: planning needs every part's shape.
+void require_geometry(const LoadedProduct& product);
+
 LoadedProduct load_product(const std::filesystem::path& file, sim::MeshCache& cache,
                            const PlacementOptions& options = {});
 

@@ -60,6 +60,7 @@ struct Options {
   std::string order, product, out = ".", sequence = "search", path = "linear";
   double wait_s = 30, lease_s = 2;
   bool verbose = false;
+  bool quiet = false;
 };
 
 class TwinProcess {
@@ -82,7 +83,7 @@ class TwinProcess {
     s.progress(progress);
     s.sim_time(clock_.now());
     status_->write(s);
-    std::cout << "[" << options_.order << "] " << state << ": " << message << std::endl;
+    if (!options_.quiet) std::cout << "[" << options_.order << "] " << state << ": " << message << std::endl;
   }
 
   void result(bool complete, const std::string& plan_file, const std::string& animation, const std::string& error) {
@@ -102,6 +103,7 @@ class TwinProcess {
     std::optional<twin::LoadedProduct> loaded;
     try {
       loaded.emplace(twin::load_product(options_.product, meshes));
+      twin::require_geometry(*loaded);
     } catch (const twin::DescriptionError& e) {
       return end_with(2, std::string("bad product description: ") + e.what());
     }
@@ -237,7 +239,7 @@ class TwinProcess {
     r.add(std::make_unique<fb::ActionBlock>("findings", [&plan](const fb::Data& d) {
       plan.findings.push_back({fb::get<std::string>(d, "kind"), fb::get<std::string>(d, "message"),
                                {fb::get<std::string>(d, "part")}});
-      std::cout << "finding: " << fb::get<std::string>(d, "message") << std::endl;
+      std::cout << "finding: " << fb::get<std::string>(d, "message") << std::endl;  // also when quiet
     }));
     r.connect("orchestrator", "FINDING", "findings", "REQ");
     bool finished = false;
@@ -295,6 +297,7 @@ int main(int argc, char** argv) {
   app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);
   app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
   app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
+  app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);

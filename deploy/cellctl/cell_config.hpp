@@ -1,0 +1,53 @@
+#pragma once
+// A cell's deployment file (deploy/cells/*.yaml) and the processes it starts.
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace cellctl {
+
+using Point = std::array<double, 3>;
+
+struct BufferConfig {
+  std::string id;
+  Point position{};
+  std::map<std::string, int> stock;
+};
+
+struct CellConfig {
+  std::filesystem::path file;
+  int domain = 42;
+  double real_time_factor = 1;
+  double liveliness_lease = 1;
+  std::string station = "station-1", arm = "arm-1";
+  Point station_position{}, dock{0.6, 0, 0}, table{1.0, 0.025, 1.0};
+  double arm_speed = 0.25, arm_angular_speed = 1.0;
+  std::string robot = "mobile-robot-1";
+  Point robot_home{1.5, 0, 1.2};
+  double robot_speed = 0.8;
+  std::vector<BufferConfig> buffers;
+
+  std::vector<std::string> resource_ids() const;
+};
+
+// "FILE:LINE: what is wrong".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+CellConfig read_cell_config(const std::filesystem::path& file);
+
+struct ProcessSpec {
+  std::string name;               // resource id, or "cell-sim"
+  std::vector<std::string> argv;  // argv[0]: the executable
+};
+
+// cell-sim first (the others wait for it), then the station, the robot, the buffers.
+std::vector<ProcessSpec> cell_processes(const CellConfig& cell, const std::filesystem::path& bin_dir);
+
+}  // namespace cellctl

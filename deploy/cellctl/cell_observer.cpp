@@ -1,0 +1,123 @@
+#include "deploy/cellctl/cell_observer.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "ordersPubSubTypes.h"
+#include "services/dds/endpoints.hpp"
+
+namespace cellctl {
+namespace {
+
+const char* event_name(cell::CommandState s) {
+  switch (s) {
+    case cell::ACCEPTED: return "accepted";
+    case cell::EXECUTING: return "executing";
+    case cell::CANCELING: return "canceling";
+    case cell::SUCCEEDED: return "succeeded";
+    case cell::CANCELED: return "canceled";
+    case cell::ABORTED: return "aborted";
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+struct CellObserver::Impl {
+  dds::ParticipantPtr participant;
+  std::unique_ptr<dds::Reader<cell::Capability, cell::CapabilityPubSubType>> capabilities;
+  std::unique_ptr<dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType>> statuses;
+  std::unique_ptr<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>> events;
+};
+
+CellObserver::CellObserver(int domain) : impl_(std::make_unique<Impl>()) {
+  impl_->participant = dds::make_participant("cellctl", {domain, true});
+  const auto changed = [this](auto&& f) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      f();
+    }
+    changed_.notify_all();
+  };
+  impl_->capabilities = std::make_unique<dds::Reader<cell::Capability, cell::CapabilityPubSubType>>(
+      impl_->participant, "cell/capabilities", dds::TopicKind::state,
+      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id()] = {c, true}; }); },
+      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id()] = {c, false}; }); });
+  impl_->statuses = std::make_unique<dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType>>(
+      impl_->participant, "cell/orders/status", dds::TopicKind::state, [this, changed](const cell::OrderStatus& s) {
+        changed([&] { orders_[s.order_id()] = s; });
+        std::function<void(const cell::OrderStatus&)> callback;
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          callback = on_status_;
+        }
+        if (callback) callback(s);
+      });
+  impl_->events = std::make_unique<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>>(
+      impl_->participant, "cell/command_events", dds::TopicKind::events, [this](const cell::CommandEvent& e) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!events_.is_open()) return;
+        nlohmann::json line{{"t", e.sim_time()},      {"resource", e.resource_id()}, {"event", event_name(e.state())},
+                            {"operation", e.operation()}, {"part", e.part()},      {"order", e.order_id()},
+                            {"command", e.command_id()}};
+        if (e.state() == cell::SUCCEEDED && e.distance() > 0) {
+          line["distance"] = e.distance();
+          line["duration"] = e.duration();
+        }
+        if (!e.reason().empty()) line["reason"] = e.reason();
+        events_ << line.dump() << '\n';
+        ++logged_;
+        if (e.state() == cell::SUCCEEDED && e.operation() == "fetch") {
+          line["event"] = "delivered";
+          events_ << line.dump() << '\n';
+          ++logged_;
+        }
+        events_.flush();
+      });
+}
+
+CellObserver::~CellObserver() = default;
+
+void CellObserver::log_events_to(const std::string& file) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  events_.open(file, std::ios::trunc);
+  if (!events_) throw std::runtime_error("cannot write " + file);
+}
+
+void CellObserver::on_status(std::function<void(const cell::OrderStatus&)> callback) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  on_status_ = std::move(callback);
+}
+
+std::vector<std::string> CellObserver::wait_for_resources(const std::vector<std::string>& ids,
+                                                          std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto missing = [&] {
+    std::vector<std::string> out;
+    for (const auto& id : ids) {
+      const auto it = resources_.find(id);
+      if (it == resources_.end() || !it->second.alive) out.push_back(id);
+    }
+    return out;
+  };
+  changed_.wait_for(lock, timeout, [&] { return missing().empty(); });
+  return missing();
+}
+
+std::map<std::string, ResourceView> CellObserver::resources() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return resources_;
+}
+
+std::map<std::string, cell::OrderStatus> CellObserver::orders() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return orders_;
+}
+
+std::size_t CellObserver::events_logged() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return logged_;
+}
+
+}  // namespace cellctl

@@ -1,0 +1,79 @@
+#include "deploy/cellctl/processes.hpp"
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+
+extern char** environ;
+
+namespace cellctl {
+namespace {
+
+int exit_code_of(int status) {
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return -1;
+}
+
+}  // namespace
+
+Process::Process(std::string name, const std::vector<std::string>& argv) : name_(std::move(name)) {
+  std::vector<std::string> copy = argv;
+  std::vector<char*> args;
+  for (auto& a : copy) args.push_back(a.data());
+  args.push_back(nullptr);
+  if (posix_spawn(&pid_, args[0], nullptr, nullptr, args.data(), environ) != 0) {
+    pid_ = -1;
+    throw std::runtime_error("cannot start " + argv[0]);
+  }
+}
+
+Process::~Process() {
+  if (pid_ > 0 && exit_code_ < 0) stop(std::chrono::milliseconds(2000));
+}
+
+int Process::poll() {
+  if (exit_code_ >= 0 || pid_ <= 0) return exit_code_;
+  int status = 0;
+  if (::waitpid(pid_, &status, WNOHANG) == pid_) exit_code_ = exit_code_of(status);
+  return exit_code_;
+}
+
+int Process::wait() {
+  if (exit_code_ >= 0) return exit_code_;
+  int status = 0;
+  if (::waitpid(pid_, &status, 0) == pid_) exit_code_ = exit_code_of(status);
+  return exit_code_;
+}
+
+int Process::stop(std::chrono::milliseconds grace) {
+  if (poll() >= 0) return exit_code_;
+  ::kill(pid_, SIGTERM);
+  const auto deadline = std::chrono::steady_clock::now() + grace;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (poll() >= 0) return exit_code_;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid_, SIGKILL);
+  return wait();
+}
+
+long Process::peak_rss_kb() const {
+  std::ifstream status("/proc/" + std::to_string(pid_) + "/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return 0;
+}
+
+std::string executable_dir() {
+  return std::filesystem::read_symlink("/proc/self/exe").parent_path().string();
+}
+
+}  // namespace cellctl

@@ -1,0 +1,39 @@
+#pragma once
+// The processes cellctl starts: spawned with their own argv, ended by their pid (SIGTERM,
+// then SIGKILL after a grace time), their peak memory read from /proc.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+namespace cellctl {
+
+class Process {
+ public:
+  Process(std::string name, const std::vector<std::string>& argv);
+  ~Process();  // ends it if it still runs
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  const std::string& name() const { return name_; }
+  pid_t pid() const { return pid_; }
+  // Its exit code once it ended by itself (-1 while it runs, 128+signal when killed).
+  int poll();
+  int wait();
+  // SIGTERM, up to `grace`, then SIGKILL; its exit code.
+  int stop(std::chrono::milliseconds grace = std::chrono::seconds(5));
+  // Peak resident memory so far (VmHWM), kB; 0 when unknown.
+  long peak_rss_kb() const;
+
+ private:
+  std::string name_;
+  pid_t pid_ = -1;
+  int exit_code_ = -1;
+};
+
+// The folder cellctl runs from: the other executables are beside it.
+std::string executable_dir();
+
+}  // namespace cellctl
