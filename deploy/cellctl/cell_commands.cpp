@@ -200,8 +200,9 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       return;
     }
     ::kill(pid, SIGTERM);
-    for (int i = 0; i < 300 && ::kill(pid, 0) == 0; ++i) std::this_thread::sleep_for(50ms);
-    if (::kill(pid, 0) == 0) {
+    // `up` removes its pid file once its processes have ended.
+    for (int i = 0; i < 300 && fs::exists(file); ++i) std::this_thread::sleep_for(50ms);
+    if (fs::exists(file)) {
       std::cerr << "error: cellctl up (pid " << pid << ") did not stop within 15 s\n";
       exit_code = 1;
       return;

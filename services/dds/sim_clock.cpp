@@ -24,11 +24,13 @@ SimClock::SimClock(ParticipantPtr participant) : impl_(std::make_unique<Impl>())
 
 SimClock::~SimClock() = default;
 
+// Never backwards: a clock sample that arrives late would otherwise pull the estimate back.
 double SimClock::now() const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_) return floor_;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - received_).count();
-  return std::max(floor_, sim_time_ + wall * factor_);
+  floor_ = std::max(floor_, sim_time_ + wall * factor_);
+  return floor_;
 }
 
 void SimClock::observe(double sim_time) {

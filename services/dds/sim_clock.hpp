@@ -29,7 +29,7 @@ class SimClock {
   double factor_ = 0;
   bool running_ = false;
   std::chrono::steady_clock::time_point received_;
-  double floor_ = 0;
+  mutable double floor_ = 0;  // the latest time handed out or observed
   std::unique_ptr<Impl> impl_;
 };
 

@@ -2,6 +2,7 @@
 // A process a test starts, and always ends: stop() sends SIGTERM and reaps it; the
 // destructor kills (SIGKILL) and reaps whatever is still running.
 
+#include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -29,13 +30,20 @@ inline void clean_stale_dds_segments() {
 
 class ChildProcess {
  public:
-  explicit ChildProcess(std::vector<std::string> argv) {
+  // `output`: a file that takes its stdout and stderr (empty: the test's own).
+  explicit ChildProcess(std::vector<std::string> argv, const std::string& output = "") {
     std::vector<char*> args;
     for (auto& a : argv) args.push_back(a.data());
     args.push_back(nullptr);
-    if (posix_spawn(&pid_, args[0], nullptr, nullptr, args.data(), environ) != 0) {
-      throw std::runtime_error("cannot start " + argv[0]);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    if (!output.empty()) {
+      posix_spawn_file_actions_addopen(&actions, 1, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      posix_spawn_file_actions_adddup2(&actions, 1, 2);
     }
+    const int failed = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (failed != 0) throw std::runtime_error("cannot start " + argv[0]);
   }
   ~ChildProcess() {
     if (pid_ > 0) {
@@ -53,6 +61,22 @@ class ChildProcess {
     ::kill(pid_, SIGKILL);
     ::waitpid(pid_, nullptr, 0);
     pid_ = -1;
+  }
+
+  // Waits up to `timeout` for it to end by itself; its exit code, or -1 (then it is stopped:
+  // SIGTERM first, so that a process that started others can end them).
+  int wait_for_exit(std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    int status = 0;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    stop();
+    return -1;
   }
 
   // SIGTERM, then waits up to `timeout` for it to exit; its exit code, or -1 if it had to

@@ -1,0 +1,252 @@
+// Asynchronous event-timing tests: the whole cell as separate processes (cellctl run, up,
+// submit, status, down; cell-sim, station, mobile robot, buffers, twins), each test on a DDS
+// domain of its own, every process ended by its id (cellctl ends the ones it starts), every
+// wait bounded. Timing is asserted in simulated time from the event log, never in wall time.
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "tests/support/child_process.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+const std::string kCell = DEFAULT_CELL;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("agile-cell-test-" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<json> read_events(const fs::path& file) {
+  std::vector<json> out;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) out.push_back(json::parse(line));
+  return out;
+}
+
+// `cellctl ARGS...` to its end (bounded), output in `log`; its exit code.
+int cellctl(std::vector<std::string> args, const fs::path& log, std::chrono::seconds timeout = 120s) {
+  args.insert(args.begin(), CELLCTL_EXE);
+  test::ChildProcess p(args, log.string());
+  return p.wait_for_exit(timeout);
+}
+
+// The part's name from its body id: "ORDER/NAME" or "ORDER/virtual/NAME".
+std::string part_name(const std::string& body) { return body.substr(body.rfind('/') + 1); }
+bool is_virtual(const std::string& body) { return body.find("/virtual/") != std::string::npos; }
+bool is_final(const std::string& event) { return event == "succeeded" || event == "aborted" || event == "canceled"; }
+
+// What every complete run's event log must show.
+void check_event_log(const std::vector<json>& events, const json& plan) {
+  const YAML::Node cell = YAML::LoadFile(kCell);
+  const double arm_speed = cell["station"]["arm_speed"].as<double>();
+  const double robot_speed = cell["mobile_robot"]["speed"].as<double>();
+
+  // Every physical part delivered before the arm grips it; deliveries in planned order.
+  std::map<std::string, double> delivered;
+  std::vector<std::string> deliveries;
+  for (const auto& e : events) {
+    if (e["event"] == "delivered") {
+      delivered[e["part"]] = e["t"];
+      deliveries.push_back(part_name(e["part"]));
+    }
+  }
+  std::vector<std::string> planned;
+  for (const auto& step : plan["steps"]) planned.push_back(step["part"]);
+  CHECK(deliveries == planned);
+  std::size_t physical_grips = 0;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const auto& e = events[i];
+    if (e["operation"] != "grip" || e["event"] != "accepted" || is_virtual(e["part"])) continue;
+    ++physical_grips;
+    INFO("grip of " << e["part"]);
+    REQUIRE(delivered.count(e["part"]));
+    CHECK(delivered[e["part"]] <= e["t"].get<double>());
+    const auto delivery = std::find_if(events.begin(), events.end(), [&](const json& d) {
+      return d["event"] == "delivered" && d["part"] == e["part"];
+    });
+    CHECK(delivery < events.begin() + i);  // and heard first
+  }
+  CHECK(physical_grips == planned.size());
+
+  // One command at a time per resource: [start, end] intervals in sim time do not overlap.
+  // The start is EXECUTING for devices that queue (the mobile robot), else ACCEPTED.
+  struct Span {
+    double start = -1, end = -1;
+  };
+  std::map<std::string, std::map<std::string, Span>> spans;  // resource -> command -> span
+  for (const auto& e : events) {
+    Span& s = spans[e["resource"]][e["command"]];
+    if (e["event"] == "executing" || (e["event"] == "accepted" && e["resource"] != "mobile-robot-1")) {
+      if (s.start < 0) s.start = e["t"];
+    }
+    if (is_final(e["event"])) s.end = e["t"];
+  }
+  for (const auto& [resource, commands] : spans) {
+    std::vector<Span> sorted;
+    for (const auto& [id, s] : commands) {
+      INFO(resource << " " << id);
+      CHECK(s.start >= 0);
+      CHECK(s.end >= s.start);
+      sorted.push_back(s);
+    }
+    std::sort(sorted.begin(), sorted.end(), [](const Span& a, const Span& b) { return a.start < b.start; });
+    for (std::size_t k = 1; k < sorted.size(); ++k) {
+      INFO(resource << ": a command from " << sorted[k].start << " s overlaps one ending " << sorted[k - 1].end << " s");
+      CHECK(sorted[k].start >= sorted[k - 1].end - 1e-6);
+    }
+  }
+
+  // Motions take distance over speed in sim time, and the events are that far apart.
+  std::size_t motions = 0;
+  for (const auto& e : events) {
+    if (e["event"] != "succeeded" || !e.contains("distance")) continue;
+    const double speed = e["operation"] == "fetch" ? robot_speed : arm_speed;
+    const double distance = e["distance"], duration = e["duration"];
+    if (e["operation"] == "rotate") continue;  // turning may take longer than the travel
+    INFO(e.dump());
+    CHECK(duration == Approx(distance / speed).epsilon(1e-6).margin(1e-9));
+    const Span& s = spans[e["resource"]][e["command"]];
+    CHECK(s.end - s.start >= duration - 1e-6);
+    ++motions;
+  }
+  CHECK(motions >= 3 * planned.size());
+}
+
+json run_product(const std::string& product, int domain, const fs::path& dir) {
+  test::clean_stale_dds_segments();
+  const int code = cellctl({"run", product, "--domain", std::to_string(domain), "--real-time-factor", "50", "--events",
+                            (dir / "events.jsonl").string(), "--out", (dir / "out").string(), "--order", "order-1"},
+                           dir / "cellctl.log");
+  INFO(read_text(dir / "cellctl.log"));
+  REQUIRE(code == 0);
+  return json::parse(read_text(dir / "out" / "plan.json"));
+}
+
+}  // namespace
+
+TEST_CASE("cell run: the Lego tower, with a collision in virtual assembly answered by another path",
+          "[process][cell][timing]") {
+  const fs::path dir = scratch("lego");
+  const json plan = run_product(std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", 186, dir);
+  const auto events = read_events(dir / "events.jsonl");
+  check_event_log(events, plan);
+
+  // The hanging brick: its first paths collide in cell-sim; each collision is followed by a
+  // release and another grip of the same part, and the last path succeeds.
+  std::size_t collisions = 0;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const auto& e = events[i];
+    if (e["event"] != "aborted") continue;
+    INFO(e.dump());
+    CHECK(std::string(e["reason"]).find("collision") != std::string::npos);
+    CHECK(is_virtual(e["part"]));
+    ++collisions;
+    const auto retry = std::find_if(events.begin() + i, events.end(), [&](const json& x) {
+      return x["operation"] == "grip" && x["part"] == e["part"] && x["event"] == "succeeded";
+    });
+    REQUIRE(retry != events.end());
+    CHECK((*retry)["t"].get<double>() >= e["t"].get<double>());
+  }
+  CHECK(collisions >= 1);
+  const auto connected = std::find_if(events.begin(), events.end(), [](const json& x) {
+    return x["operation"] == "connect" && x["event"] == "succeeded" && x["part"] == "order-1/virtual/hanging";
+  });
+  CHECK(connected != events.end());
+  bool reported = false;
+  for (const auto& f : plan["findings"]) reported |= f["kind"] == "collision" && f["message"].get<std::string>().find("cell-sim") != std::string::npos;
+  CHECK(reported);
+}
+
+TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "[process][cell][timing]") {
+  const fs::path dir = scratch("cranfield");
+  const json plan = run_product(std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", 187, dir);
+  CHECK(plan["complete"] == true);
+  check_event_log(read_events(dir / "events.jsonl"), plan);
+  CHECK(fs::file_size(dir / "out" / "animation.gltf") > 1000);
+}
+
+TEST_CASE("cell up: a bad order fails alone, the cell stays idle and usable, down ends it", "[process][cell]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = scratch("bad-order");
+  const std::string domain = "188";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "50"}, (dir / "up.log").string());
+
+  const int bad = cellctl({"submit", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "--domain", domain,
+                           "--order", "bad", "--out", (dir / "bad").string()},
+                          dir / "bad.log");
+  const std::string bad_log = read_text(dir / "bad.log");
+  INFO(bad_log);
+  CHECK(bad == 2);
+  CHECK(bad_log.find("unknown_link_id.aml:") != std::string::npos);  // file and line
+
+  const int good = cellctl({"submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain", domain,
+                            "--order", "good", "--out", (dir / "good").string()},
+                           dir / "good.log");
+  INFO(read_text(dir / "good.log") << read_text(dir / "up.log"));
+  CHECK(good == 0);
+
+  CHECK(cellctl({"status", "--domain", domain}, dir / "status.log", 30s) == 0);
+  const std::string status = read_text(dir / "status.log");
+  INFO(status);
+  CHECK(status.find("gone") == std::string::npos);
+  std::istringstream lines(status);
+  bool station_listed = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("station-1", 0) != 0) continue;
+    station_listed = true;
+    CHECK(line.find("alive") != std::string::npos);
+    CHECK(line.find("good") == std::string::npos);  // the order ended: its reservation too
+  }
+  CHECK(station_listed);
+
+  CHECK(cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[process][cell]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = scratch("early-twin");
+  const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+
+  SECTION("nothing comes: the twin gives up with a clear message") {
+    test::ChildProcess twin({TWIN_EXE, "--domain", "189", "--order", "alone", "--product", product, "--out",
+                             (dir / "alone").string(), "--wait", "2"},
+                            (dir / "alone.log").string());
+    CHECK(twin.wait_for_exit(30s) == 1);
+    const std::string log = read_text(dir / "alone.log");
+    INFO(log);
+    CHECK(log.find("did not appear within 2 s") != std::string::npos);
+  }
+  SECTION("the cell comes later: the twin goes on and assembles") {
+    test::ChildProcess twin({TWIN_EXE, "--domain", "190", "--order", "early", "--product", product, "--out",
+                             (dir / "early").string(), "--wait", "60"},
+                            (dir / "early.log").string());
+    std::this_thread::sleep_for(1s);
+    test::ChildProcess up({CELLCTL_EXE, "up", "--domain", "190", "--real-time-factor", "50"}, (dir / "up.log").string());
+    const int code = twin.wait_for_exit(90s);
+    INFO(read_text(dir / "early.log") << read_text(dir / "up.log"));
+    CHECK(code == 0);
+    CHECK(up.stop(20s) == 0);
+  }
+}
