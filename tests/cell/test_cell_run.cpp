@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -110,7 +111,8 @@ void check_event_log(const std::vector<json>& events, const json& plan) {
       CHECK(s.end >= s.start);
       sorted.push_back(s);
     }
-    std::sort(sorted.begin(), sorted.end(), [](const Span& a, const Span& b) { return a.start < b.start; });
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Span& a, const Span& b) { return std::tie(a.start, a.end) < std::tie(b.start, b.end); });
     for (std::size_t k = 1; k < sorted.size(); ++k) {
       INFO(resource << ": a command from " << sorted[k].start << " s overlaps one ending " << sorted[k - 1].end << " s");
       CHECK(sorted[k].start >= sorted[k - 1].end - 1e-6);

@@ -1,0 +1,173 @@
+// Benchmarks of the distributed cell, between real processes on one host (localhost-only DDS):
+//  1. a bare Fast DDS ping-pong (the project's typed writer and reader, the events QoS, no
+//     function blocks) between this process and an echo child;
+//  2. a command's round trip from a sender to a resource process (a buffer: commands topic,
+//     function-block resource, life cycle, command events) until SUCCEEDED;
+//  3. the time from starting a twin to its first status, and to it having planned.
+// Prints p50 and p99 of each. Run: build/release/bin/bench_cell [--rounds N]
+//   (internal: bench_cell --echo DOMAIN is the ping-pong's other side)
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <cstring>
+#include <iostream>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "commandsPubSubTypes.h"
+#include "ordersPubSubTypes.h"
+#include "services/dds/endpoints.hpp"
+#include "tests/support/child_process.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+volatile std::sig_atomic_t running = 1;
+void stop(int) { running = 0; }
+
+using CommandWriter = dds::Writer<cell::Command, cell::CommandPubSubType>;
+using CommandReader = dds::Reader<cell::Command, cell::CommandPubSubType>;
+using EventWriter = dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>;
+using EventReader = dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>;
+
+// Waits for the answer to each request, one at a time.
+struct Answers {
+  std::mutex mutex;
+  std::condition_variable arrived;
+  std::string last;
+  void answer(const std::string& id) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      last = id;
+    }
+    arrived.notify_all();
+  }
+  bool wait(const std::string& id) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return arrived.wait_for(lock, 5s, [&] { return last == id; });
+  }
+};
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * v.size()))];
+}
+
+void report(const std::string& what, const std::vector<double>& us) {
+  std::cout << what << ": p50 " << percentile(us, 0.5) << " us, p99 " << percentile(us, 0.99) << " us (" << us.size()
+            << " rounds)" << std::endl;
+}
+
+int echo(int domain) {
+  std::signal(SIGTERM, stop);
+  auto participant = dds::make_participant("bench-echo", {domain, true});
+  EventWriter pong(participant, "bench/pong", dds::TopicKind::events);
+  CommandReader ping(participant, "bench/ping", dds::TopicKind::events, [&](const cell::Command& c) {
+    cell::CommandEvent e;
+    e.command_id(c.command_id());
+    e.state(cell::SUCCEEDED);
+    pong.write(e);
+  });
+  while (running) std::this_thread::sleep_for(50ms);
+  return 0;
+}
+
+// Sends `rounds` commands on `topic`, each after the answer to the one before.
+std::vector<double> round_trips(const dds::ParticipantPtr& participant, const std::string& topic,
+                                const std::string& answers_topic, const std::string& resource, int rounds) {
+  Answers answers;
+  EventReader reader(participant, answers_topic, dds::TopicKind::events, [&](const cell::CommandEvent& e) {
+    if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id());
+  });
+  CommandWriter writer(participant, topic, dds::TopicKind::events);
+  if (!writer.wait_for_readers(1, 20s)) throw std::runtime_error("nobody reads " + topic);
+  std::this_thread::sleep_for(300ms);  // the reader's side of the match, too
+  std::vector<double> us;
+  for (int i = -20; i < rounds; ++i) {  // 20 warm-up rounds
+    cell::Command c;
+    c.command_id(resource + "-" + std::to_string(i + 100));
+    c.resource_id(resource);
+    c.operation("give");
+    c.part_type("Part");
+    const auto start = Clock::now();
+    writer.write(c);
+    if (!answers.wait(c.command_id())) throw std::runtime_error("no answer to " + c.command_id());
+    if (i >= 0) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+  }
+  return us;
+}
+
+void twin_start(int domain, int rounds) {
+  auto participant = dds::make_participant("bench-observer", {domain, true});
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::map<std::string, int> seen;  // order -> statuses seen
+  dds::QosSettings qos;
+  dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType> statuses(
+      participant, "cell/orders/status", dds::TopicKind::state,
+      [&](const cell::OrderStatus& s) {
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          ++seen[s.order_id()];
+        }
+        changed.notify_all();
+      },
+      {}, qos);
+  std::vector<double> first_status, planned;
+  for (int i = 0; i < rounds; ++i) {
+    const std::string order = "bench-" + std::to_string(i);
+    const auto start = Clock::now();
+    test::ChildProcess twin({TWIN_EXE, "--domain", std::to_string(domain), "--order", order, "--product",
+                             std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "--out", "/tmp/bench-twin",
+                             "--wait", "1", "--quiet"},
+                            "/dev/null");
+    std::unique_lock<std::mutex> lock(mutex);
+    if (changed.wait_for(lock, 10s, [&] { return seen[order] >= 1; })) {
+      first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+    }
+    // SUBMITTED, PLANNING, then NEGOTIATING ("calling for proposals") once planned.
+    if (changed.wait_for(lock, 10s, [&] { return seen[order] >= 3; })) {
+      planned.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+    }
+    lock.unlock();
+    twin.stop();
+  }
+  report("twin start to its first status (Cranfield)", first_status);
+  report("twin start to planned and negotiating (Cranfield)", planned);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 3 && std::strcmp(argv[1], "--echo") == 0) return echo(std::stoi(argv[2]));
+  int rounds = 1000;
+  if (argc == 3 && std::strcmp(argv[1], "--rounds") == 0) rounds = std::stoi(argv[2]);
+  test::clean_stale_dds_segments();
+  const int domain = 199;
+  try {
+    auto participant = dds::make_participant("bench", {domain, true});
+    {
+      test::ChildProcess echo_side({argv[0], "--echo", std::to_string(domain)});
+      report("bare Fast DDS ping-pong, two processes", round_trips(participant, "bench/ping", "bench/pong", "echo", rounds));
+      echo_side.stop();
+    }
+    {
+      test::ChildProcess buffer({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(domain), "--stock",
+                                 "Part=1000000"});
+      report("command to SUCCEEDED, buffer process", round_trips(participant, "cell/commands", "cell/command_events",
+                                                                 "bench-buffer", rounds));
+      buffer.stop();
+    }
+    twin_start(domain + 1, 10);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
