@@ -13,6 +13,7 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
   qos.resource_limits().max_instances = 0;
   qos.resource_limits().max_samples_per_instance = 0;
   qos.resource_limits().max_samples = 0;
+  qos.data_sharing().off();
   if (kind == TopicKind::state) {
     qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = KEEP_LAST_HISTORY_QOS;
