@@ -1,6 +1,7 @@
 #include "deploy/cellctl/cell_commands.hpp"
 
 #include <signal.h>
+#include <sys/resource.h>
 
 #include <csignal>
 #include <filesystem>
@@ -123,6 +124,9 @@ int submit(const CellConfig& cell, SubmitOptions o, CellObserver& observer, doub
   }
   observer.on_status({});
   const int code = twin.poll();
+  // The twin is the only child reaped so far: the children's peak is its own.
+  struct rusage usage {};
+  if (::getrusage(RUSAGE_CHILDREN, &usage) == 0) std::cout << "twin peak RSS " << usage.ru_maxrss / 1024 << " MB\n";
   if (code == 0) std::cout << "order " << o.order << " done: " << o.out << "/plan.json, " << o.out << "/animation.gltf\n";
   return code;
 }

@@ -252,3 +252,32 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
     CHECK(up.stop(20s) == 0);
   }
 }
+
+TEST_CASE("a resource that dies during an order: the twin fails it with the reason", "[process][cell]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = scratch("robot-dies");
+  const std::string domain = "191", bin = fs::path(TWIN_EXE).parent_path().string();
+  test::ChildProcess sim({bin + "/cell-sim", "--domain", domain, "--real-time-factor", "20"}, (dir / "sim.log").string());
+  test::ChildProcess station({bin + "/station", "--domain", domain, "--lease", "0.5"}, (dir / "station.log").string());
+  test::ChildProcess robot({bin + "/mobile-robot", "--domain", domain, "--lease", "0.5"}, (dir / "robot.log").string());
+  test::ChildProcess buffer({bin + "/buffer", "--domain", domain, "--id", "buffer-1", "--position", "2", "0", "0",
+                             "--stock", "Brick2x4=20", "--stock", "Brick2x2=20", "--lease", "0.5"},
+                            (dir / "buffer.log").string());
+  test::ChildProcess twin({TWIN_EXE, "--domain", domain, "--order", "o1", "--product",
+                           std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--out", (dir / "o1").string()},
+                          (dir / "twin.log").string());
+  // Once physical assembly has begun, the mobile robot dies without a word.
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (read_text(dir / "twin.log").find("PHYSICAL_ASSEMBLY") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  REQUIRE(read_text(dir / "twin.log").find("PHYSICAL_ASSEMBLY") != std::string::npos);
+  robot.kill_hard();
+  const int code = twin.wait_for_exit(30s);
+  const std::string log = read_text(dir / "twin.log");
+  INFO(log);
+  CHECK(code == 1);
+  CHECK(log.find("mobile-robot-1 disappeared (its liveliness lease ran out)") != std::string::npos);
+  for (auto* p : {&buffer, &station, &sim}) CHECK(p->stop() == 0);
+}
