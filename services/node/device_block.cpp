@@ -8,6 +8,8 @@ DeviceBlock::DeviceBlock(std::string name, std::string resource_id, std::set<std
       operations_(std::move(operations)) {
   declare_input("COMMAND", {"command_id", "resource_id", "operation"});
   declare_input("START", {"command_id"});
+  declare_input("ORDER_ENDED", {"order_id"});
+  declare_input("ORDER_ACTIVE", {"order_id"});
   declare_output("ACCEPT", {"command_id"});
   declare_output("PROGRESS", {"progress"});
   declare_output("DONE");
@@ -30,9 +32,19 @@ void DeviceBlock::receive(const Event& event) {
     emit("ACCEPT", {{"command_id", id}});
     return;
   }
+  if (event.name == "ORDER_ENDED") {
+    ended_orders_.insert(get<std::string>(event.data, "order_id"));
+    return;
+  }
+  if (event.name == "ORDER_ACTIVE") {
+    ended_orders_.erase(get<std::string>(event.data, "order_id"));
+    return;
+  }
   if (event.name == "START") {
     Data full = command(get<std::string>(event.data, "command_id"));
     if (full.empty()) return emit("FAIL", {{"reason", std::string("unknown command")}});
+    const std::string order = get_or<std::string>(full, "order_id", "");
+    if (ended_orders_.count(order)) return emit("FAIL", {{"reason", "order " + order + " has ended"}});
     if (!operations_.count(get<std::string>(full, "operation"))) {
       return emit("FAIL", {{"reason", resource_id_ + " cannot " + get<std::string>(full, "operation")}});
     }

@@ -8,7 +8,10 @@
 //   inputs                                  outputs
 //   COMMAND (command_id, resource_id,       ACCEPT   (command_id)    to the life cycle
 //            operation, ...)                PROGRESS, DONE, FAIL     to the life cycle
-//   START   (command_id) -> the ECC's START with the command's data
+//   START   (command_id) -> the ECC's START with the command's data; a command of an order
+//           that has ended meanwhile fails at once ("order X has ended"), so a queue of
+//           work for a failed order drains instead of being carried out
+//   ORDER_ENDED, ORDER_ACTIVE (order_id): from the orders' status (an id may come again)
 // A device adds its own inputs and outputs (replies from cell-sim, requests to it).
 
 #include <map>
@@ -35,6 +38,7 @@ class DeviceBlock : public BasicBlock {
   std::string resource_id_;
   std::set<std::string> operations_;
   std::map<std::string, Data> commands_;
+  std::set<std::string> ended_orders_;
 };
 
 }  // namespace fb

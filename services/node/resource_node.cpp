@@ -25,16 +25,19 @@ const std::pair<const char*, cell::CommandState> kLifecycleOutputs[] = {
 
 bool is_final(cell::CommandState s) { return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED; }
 
-// Order status -> ORDER_ENDED when an order is done, failed, or its twin is gone.
+// Order status -> ENDED when an order is done, failed, or its twin is gone; ACTIVE while it
+// runs (an order id may be used again).
 class OrderWatch : public fb::FunctionBlock {
  public:
   OrderWatch() : FunctionBlock("order_watch") {
     declare_input("STATUS", {"order_id", "ended"});
     declare_input("GONE", {"order_id"});
     declare_output("ENDED", {"order_id"});
+    declare_output("ACTIVE", {"order_id"});
   }
   void receive(const fb::Event& e) override {
-    if (e.name == "GONE" || fb::get<bool>(e.data, "ended")) emit("ENDED", {{"order_id", e.data.at("order_id")}});
+    const bool ended = e.name == "GONE" || fb::get<bool>(e.data, "ended");
+    emit(ended ? "ENDED" : "ACTIVE", {{"order_id", e.data.at("order_id")}});
   }
 };
 
@@ -146,6 +149,8 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.connect("orders", "IND", "order_watch", "STATUS");
   resource.connect("orders", "GONE", "order_watch", "GONE");
   resource.connect("order_watch", "ENDED", "contractor", "ORDER_ENDED");
+  resource.connect("order_watch", "ENDED", dev, "ORDER_ENDED");
+  resource.connect("order_watch", "ACTIVE", dev, "ORDER_ACTIVE");
   const std::string id = n.config.id;
   n.publish<cell::Proposal, cell::ProposalPubSubType>("proposals", "cell/negotiation/proposals",
                                                       [id](const fb::Data& d) {

@@ -119,3 +119,14 @@ TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the fi
   world.set_static("box", true);
   CHECK(world.is_static("box"));
 }
+
+TEST_CASE("device: work queued for an order that has ended fails at once", "[fb][device]") {
+  fb::BlockTestFixture<fb::MobileRobotBlock> f("robot", "robot-1", fb::Numbers{1, 0, 1}, 0.5);
+  f.send("SIM_REPLY", reply_to(f.send("INIT")[0]));
+  f.send("COMMAND", {{"command_id", std::string("f1")}, {"resource_id", std::string("robot-1")},
+                     {"operation", std::string("fetch")}, {"order_id", std::string("o1")}});
+  f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
+  const auto started = f.send("START", {{"command_id", std::string("f1")}});
+  REQUIRE(names<fb::MobileRobotBlock>(started) == Names{"FAIL"});
+  CHECK(fb::get<std::string>(started[0].data, "reason") == "order o1 has ended");
+}
