@@ -110,14 +110,15 @@ void twin_start(int domain, int rounds) {
   auto participant = dds::make_participant("bench-observer", {domain, true});
   std::mutex mutex;
   std::condition_variable changed;
-  std::map<std::string, int> seen;  // order -> statuses seen
+  // The latest status per order (keep last 1: statuses in quick succession may coalesce).
+  std::map<std::string, cell::OrderStatus> seen;
   dds::QosSettings qos;
   dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType> statuses(
       participant, "cell/orders/status", dds::TopicKind::state,
       [&](const cell::OrderStatus& s) {
         {
           std::lock_guard<std::mutex> lock(mutex);
-          ++seen[s.order_id()];
+          seen[s.order_id()] = s;
         }
         changed.notify_all();
       },
@@ -131,11 +132,16 @@ void twin_start(int domain, int rounds) {
                              "--wait", "5", "--quiet"},
                             "/dev/null");
     std::unique_lock<std::mutex> lock(mutex);
-    if (changed.wait_for(lock, 10s, [&] { return seen[order] >= 1; })) {
+    if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
       first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     }
-    // SUBMITTED, PLANNING, then NEGOTIATING ("calling for proposals") once planned.
-    if (changed.wait_for(lock, 10s, [&] { return seen[order] >= 3; })) {
+    // Planned, cell-sim found: the twin calls for proposals (and, with no resources here,
+    // waits for them until --wait runs out).
+    const auto negotiating = [&] {
+      const auto it = seen.find(order);
+      return it != seen.end() && it->second.message() == "calling for proposals";
+    };
+    if (changed.wait_for(lock, 10s, negotiating)) {
       planned.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     }
     lock.unlock();
