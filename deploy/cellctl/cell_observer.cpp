@@ -5,22 +5,12 @@
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "ordersPubSubTypes.h"
+#include "services/dds/conversions.hpp"
 #include "services/dds/endpoints.hpp"
 
 namespace cellctl {
 namespace {
 
-const char* event_name(cell::CommandState s) {
-  switch (s) {
-    case cell::ACCEPTED: return "accepted";
-    case cell::EXECUTING: return "executing";
-    case cell::CANCELING: return "canceling";
-    case cell::SUCCEEDED: return "succeeded";
-    case cell::CANCELED: return "canceled";
-    case cell::ABORTED: return "aborted";
-  }
-  return "unknown";
-}
 
 }  // namespace
 
@@ -58,7 +48,7 @@ CellObserver::CellObserver(int domain) : impl_(std::make_unique<Impl>()) {
       impl_->participant, "cell/command_events", dds::TopicKind::events, [this](const cell::CommandEvent& e) {
         std::lock_guard<std::mutex> lock(mutex_);
         if (!events_.is_open()) return;
-        nlohmann::json line{{"t", e.sim_time()},      {"resource", e.resource_id()}, {"event", event_name(e.state())},
+        nlohmann::json line{{"t", e.sim_time()},      {"resource", e.resource_id()}, {"event", dds::state_name(e.state())},
                             {"operation", e.operation()}, {"part", e.part()},      {"order", e.order_id()},
                             {"command", e.command_id()}};
         if (e.state() == cell::SUCCEEDED && e.distance() > 0) {

@@ -61,6 +61,18 @@ std::vector<std::string> split(const std::string& joined) {
 
 namespace dds {
 
+const char* state_name(cell::CommandState state) {
+  switch (state) {
+    case cell::ACCEPTED: return "accepted";
+    case cell::EXECUTING: return "executing";
+    case cell::CANCELING: return "canceling";
+    case cell::SUCCEEDED: return "succeeded";
+    case cell::CANCELED: return "canceled";
+    case cell::ABORTED: return "aborted";
+  }
+  return "unknown";
+}
+
 fb::Data to_data(const cell::Command& c) {
   return {{"command_id", c.command_id()},   {"resource_id", c.resource_id()}, {"order_id", c.order_id()},
           {"operation", c.operation()},     {"part", c.part()},               {"part_type", c.part_type()},

@@ -27,6 +27,8 @@ std::vector<std::string> split(const std::string& joined);
 namespace dds {
 
 // Every field, by its IDL name; path, size and direction as numbers.
+// "accepted", "executing", ..., as event data and the event log name them.
+const char* state_name(cell::CommandState state);
 fb::Data to_data(const cell::Command& command);
 cell::Command to_command(const fb::Data& data);  // missing fields stay empty
 fb::Data to_data(const cell::SimReply& reply);

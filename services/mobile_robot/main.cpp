@@ -19,18 +19,6 @@
 namespace {
 volatile std::sig_atomic_t running = 1;
 void stop(int) { running = 0; }
-
-const char* state_name(cell::CommandState s) {
-  switch (s) {
-    case cell::ACCEPTED: return "accepted";
-    case cell::EXECUTING: return "executing";
-    case cell::CANCELING: return "canceling";
-    case cell::SUCCEEDED: return "succeeded";
-    case cell::CANCELED: return "canceled";
-    case cell::ABORTED: return "aborted";
-  }
-  return "unknown";
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -60,7 +48,7 @@ int main(int argc, char** argv) {
         }));
     auto& give_events = resource.add(std::make_unique<dds::SubscribeBlock<cell::CommandEvent, cell::CommandEventPubSubType>>(
         "give_events", participant, "cell/command_events", dds::TopicKind::events, [](const cell::CommandEvent& e) {
-          return fb::Data{{"command_id", e.command_id()}, {"state", std::string(state_name(e.state()))},
+          return fb::Data{{"command_id", e.command_id()}, {"state", std::string(dds::state_name(e.state()))},
                           {"reason", e.reason()}};
         }));
     resource.add(std::make_unique<dds::PublishBlock<cell::Command, cell::CommandPubSubType>>(

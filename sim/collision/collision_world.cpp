@@ -71,6 +71,13 @@ void MovingBody::add_box(const std::string& member, const Eigen::Vector3d& half_
 
 bool MovingBody::empty() const { return impl_->shapes.empty(); }
 
+Pose interpolate(const Pose& from, const Pose& to, double s) {
+  Pose pose = Pose::Identity();
+  pose.linear() = Eigen::Quaterniond(from.linear()).slerp(s, Eigen::Quaterniond(to.linear())).toRotationMatrix();
+  pose.translation() = (1 - s) * from.translation() + s * to.translation();
+  return pose;
+}
+
 // --- CollisionWorld -----------------------------------------------------------------------
 
 struct CollisionWorld::Impl {
@@ -220,13 +227,6 @@ struct AnyOverlap : btBroadphaseAabbCallback {
     return false;
   }
 };
-
-Pose interpolate(const Pose& from, const Pose& to, double s) {
-  Pose pose = Pose::Identity();
-  pose.linear() = Eigen::Quaterniond(from.linear()).slerp(s, Eigen::Quaterniond(to.linear())).toRotationMatrix();
-  pose.translation() = (1 - s) * from.translation() + s * to.translation();
-  return pose;
-}
 
 }  // namespace
 

@@ -36,6 +36,9 @@ struct Contact {
 
 class CollisionWorld;
 
+// The pose a fraction s (0..1) of the way: translation linear, rotation slerp.
+Pose interpolate(const Pose& from, const Pose& to, double s);
+
 // Something that moves: named members, each a convex decomposition at an offset.
 class MovingBody {
  public:
@@ -54,6 +57,9 @@ class MovingBody {
 
  private:
   friend class CollisionWorld;
+
+// The pose a fraction s (0..1) of the way: translation linear, rotation slerp.
+Pose interpolate(const Pose& from, const Pose& to, double s);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   double radius_ = 0;

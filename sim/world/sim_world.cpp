@@ -3,17 +3,6 @@
 #include <algorithm>
 
 namespace sim {
-namespace {
-
-Pose interpolate(const Pose& from, const Pose& to, double s) {
-  Pose pose = Pose::Identity();
-  pose.linear() = Eigen::Quaterniond(from.linear()).slerp(s, Eigen::Quaterniond(to.linear())).toRotationMatrix();
-  pose.translation() = (1 - s) * from.translation() + s * to.translation();
-  return pose;
-}
-
-}  // namespace
-
 SimWorld::SimWorld(CollisionOptions options) : world_(options) {}
 
 SimWorld::Body& SimWorld::body(const std::string& id) {

@@ -58,6 +58,7 @@ class ChildProcess {
 
   // SIGKILL: the process gets no chance to say goodbye (a crash, a power cut).
   void kill_hard() {
+    if (pid_ <= 0) return;
     ::kill(pid_, SIGKILL);
     ::waitpid(pid_, nullptr, 0);
     pid_ = -1;
@@ -66,23 +67,22 @@ class ChildProcess {
   // Waits up to `timeout` for it to end by itself; its exit code, or -1 (then it is stopped:
   // SIGTERM first, so that a process that started others can end them).
   int wait_for_exit(std::chrono::milliseconds timeout) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    int status = 0;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    stop();
-    return -1;
+    const int code = reap_within(timeout);
+    if (pid_ > 0) stop();
+    return code;
   }
 
   // SIGTERM, then waits up to `timeout` for it to exit; its exit code, or -1 if it had to
   // be killed.
   int stop(std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+    if (pid_ <= 0) return -1;  // reaped already; kill(-1) would signal every process
     ::kill(pid_, SIGTERM);
+    return reap_within(timeout);  // if still running: the destructor kills it
+  }
+
+ private:
+  // Its exit code once it ended within `timeout` (pid_ then -1), else -1.
+  int reap_within(std::chrono::milliseconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
     int status = 0;
     while (std::chrono::steady_clock::now() < deadline) {
@@ -92,10 +92,9 @@ class ChildProcess {
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    return -1;  // the destructor kills it
+    return -1;
   }
 
- private:
   pid_t pid_ = -1;
 };
 

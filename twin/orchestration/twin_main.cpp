@@ -43,17 +43,6 @@ cell::OrderState order_state(const std::string& s) {
   return states.at(s);
 }
 
-const char* state_name(cell::CommandState s) {
-  switch (s) {
-    case cell::ACCEPTED: return "accepted";
-    case cell::EXECUTING: return "executing";
-    case cell::CANCELING: return "canceling";
-    case cell::SUCCEEDED: return "succeeded";
-    case cell::CANCELED: return "canceled";
-    case cell::ABORTED: return "aborted";
-  }
-  return "unknown";
-}
 
 struct Options {
   dds::ParticipantSettings dds;
@@ -184,9 +173,9 @@ class TwinProcess {
     subscribe<cell::CommandEvent, cell::CommandEventPubSubType>(
         r, "command_events", "cell/command_events", TopicKind::events, [this](const cell::CommandEvent& e) {
           clock_.observe(e.sim_time());
-          if (options_.verbose) std::cout << "  event " << e.command_id() << " " << state_name(e.state()) << " " << e.reason() << std::endl;
+          if (options_.verbose) std::cout << "  event " << e.command_id() << " " << dds::state_name(e.state()) << " " << e.reason() << std::endl;
           return fb::Data{{"command_id", e.command_id()}, {"order_id", e.order_id()},
-                          {"resource_id", e.resource_id()}, {"state", std::string(state_name(e.state()))},
+                          {"resource_id", e.resource_id()}, {"state", std::string(dds::state_name(e.state()))},
                           {"reason", e.reason()}};
         }, "COMMAND_EVENT");
     subscribe<cell::SimReply, cell::SimReplyPubSubType>(
