@@ -179,11 +179,12 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     CellObserver observer(cell.domain);
     observer.wait_for_resources(cell.resource_ids(), 2s);
     std::this_thread::sleep_for(300ms);  // orders and resources outside the file
-    TextTable resources({"resource", "kind", "state", "reserved by", "stock"});
+    TextTable resources({"resource", "kind", "state", "work", "reserved by", "stock"});
     for (const auto& [id, r] : observer.resources()) {
       std::string stock;
       for (const auto& s : r.capability.stock()) stock += s.part_type() + "=" + std::to_string(s.count()) + " ";
-      resources.add_row({id, r.capability.kind(), r.alive ? "alive" : "gone", r.capability.reserved_by(), stock});
+      resources.add_row({id, r.capability.kind(), r.alive ? "alive" : "gone", r.capability.busy() ? "busy" : "idle",
+                         r.capability.reserved_by(), stock});
     }
     std::cout << "Cell on domain " << cell.domain << ": " << observer.resources().size() << " resources\n\n";
     resources.print(std::cout);

@@ -5,6 +5,7 @@
 #include "negotiationPubSubTypes.h"
 #include "ordersPubSubTypes.h"
 #include "services/blocks/action_block.hpp"
+#include "services/blocks/order_watch.hpp"
 #include "services/dds/conversions.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "simulationPubSubTypes.h"
@@ -25,21 +26,6 @@ const std::pair<const char*, cell::CommandState> kLifecycleOutputs[] = {
 
 bool is_final(cell::CommandState s) { return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED; }
 
-// Order status -> ENDED when an order is done, failed, or its twin is gone; ACTIVE while it
-// runs (an order id may be used again).
-class OrderWatch : public fb::FunctionBlock {
- public:
-  OrderWatch() : FunctionBlock("order_watch") {
-    declare_input("STATUS", {"order_id", "ended"});
-    declare_input("GONE", {"order_id"});
-    declare_output("ENDED", {"order_id"});
-    declare_output("ACTIVE", {"order_id"});
-  }
-  void receive(const fb::Event& e) override {
-    const bool ended = e.name == "GONE" || fb::get<bool>(e.data, "ended");
-    emit(ended ? "ENDED" : "ACTIVE", {{"order_id", e.data.at("order_id")}});
-  }
-};
 
 }  // namespace
 
@@ -54,6 +40,9 @@ struct ResourceNode::Impl {
   std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
   std::vector<std::function<void()>> starters;
   Pub<cell::SimRequest, cell::SimRequestPubSubType>* sim_requests = nullptr;
+  fb::CommandLifecycle* lifecycle = nullptr;
+  bool busy = false;  // as last published
+  std::function<void()> publish_capability;
 
   Impl(fb::Resource& r, dds::ParticipantPtr p, NodeConfig c, fb::DeviceBlock& d)
       : resource(r), participant(p), config(std::move(c)), device(d), clock(p) {}
@@ -88,6 +77,13 @@ struct ResourceNode::Impl {
     if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
     e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
     if (is_final(state)) device.forget(id);
+    if (lifecycle->state() != "IDLE" && !busy) {
+      busy = true;
+      publish_capability();
+    } else if (lifecycle->state() == "IDLE" && busy) {
+      busy = false;
+      publish_capability();
+    }
     return e;
   }
 };
@@ -104,7 +100,8 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
 
   // Commands and their life cycle.
   const std::string dev = device.name();
-  resource.add(std::make_unique<fb::CommandLifecycle>("lifecycle", n.config.when_busy));
+  n.lifecycle = &resource.add(std::make_unique<fb::CommandLifecycle>("lifecycle", n.config.when_busy));
+  n.publish_capability = [this] { publish_capability(); };
   n.subscribe<cell::Command, cell::CommandPubSubType>("commands", "cell/commands", TopicKind::events,
                                                      [](const cell::Command& c) { return dds::to_data(c); });
   resource.connect("commands", "IND", dev, "COMMAND");
@@ -142,7 +139,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
       "orders", "cell/orders/status", TopicKind::state, [](const cell::OrderStatus& s) {
         return fb::Data{{"order_id", s.order_id()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
       });
-  resource.add(std::make_unique<OrderWatch>());
+  resource.add(std::make_unique<fb::OrderWatch>());
   resource.connect("calls", "IND", "contractor", "CFP");
   resource.connect("awards", "IND", "contractor", "AWARD");
   resource.connect("releases", "IND", "contractor", "RELEASE");
@@ -214,6 +211,7 @@ void ResourceNode::publish_capability() {
   c.speed(n.config.speed);
   c.angular_speed(n.config.angular_speed);
   c.reserved_by(n.contractor->reserved_by());
+  c.busy(n.busy);
   if (n.describe) n.describe(c);
   n.capabilities->write(c);
 }

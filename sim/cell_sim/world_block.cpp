@@ -37,6 +37,7 @@ WorldBlock::WorldBlock(std::string name, double real_time_factor, double clock_p
   if (real_time_factor <= 0) throw std::invalid_argument("the real-time factor must be above 0");
   declare_input("REQUEST", {"request_id", "requester", "kind", "body_id"});
   declare_input("TICK");
+  declare_input("ORDER_ENDED", {"order_id"});
   declare_output("REPLY", {"request_id", "requester", "ok", "error", "collided", "start_time", "end_time"});
   declare_output("CLOCK", {"sim_time", "real_time_factor"});
 }
@@ -47,6 +48,13 @@ double WorldBlock::now() const {
 
 void WorldBlock::receive(const fb::Event& event) {
   if (event.name == "REQUEST") handle(event.data);
+  if (event.name == "ORDER_ENDED") {
+    const std::string& order = fb::get<std::string>(event.data, "order_id");
+    for (auto it = owner_.begin(); it != owner_.end();) {
+      if (it->second == order && world_.pose(it->first)) world_.remove(it->first);
+      it = it->second == order ? owner_.erase(it) : std::next(it);
+    }
+  }
   publish_due();
 }
 
@@ -62,8 +70,10 @@ void WorldBlock::handle(const fb::Data& d) {
       const fb::Numbers& h = fb::get<fb::Numbers>(d, "half_extents");
       world_.spawn({id, fb::get<std::string>(d, "mesh_uri"), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
                     pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get<bool>(d, "is_static")});
+      owner_[id] = fb::get<std::string>(d, "requester");
     } else if (kind == "remove") {
       world_.remove(id);
+      owner_.erase(id);
     } else if (kind == "set_static" || kind == "set_movable") {
       world_.set_static(id, kind == "set_static");
     } else if (kind == "move") {

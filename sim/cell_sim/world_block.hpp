@@ -6,6 +6,8 @@
 //   inputs                          outputs
 //   REQUEST (SimRequest fields)     REPLY (SimReply fields)
 //   TICK                            CLOCK (sim_time, real_time_factor), every clock_period
+//   ORDER_ENDED (order_id): the bodies that order spawned leave the world (a twin that died
+//   leaves nothing behind for the next order)
 
 #include <chrono>
 #include <map>
@@ -33,6 +35,7 @@ class WorldBlock : public fb::FunctionBlock {
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_clock_{};
   std::multimap<double, fb::Data> pending_;  // replies by the sim time they are due
+  std::map<std::string, std::string> owner_;  // body -> the requester that spawned it
 };
 
 }  // namespace sim

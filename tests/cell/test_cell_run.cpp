@@ -281,3 +281,32 @@ TEST_CASE("a resource that dies during an order: the twin fails it with the reas
   CHECK(log.find("mobile-robot-1 disappeared (its liveliness lease ran out)") != std::string::npos);
   for (auto* p : {&buffer, &station, &sim}) CHECK(p->stop() == 0);
 }
+
+TEST_CASE("a twin that dies mid-order: its reservations lapse, its parts leave cell-sim, the next order runs",
+          "[process][cell]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = scratch("twin-dies");
+  const std::string domain = "192";
+  const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "20"}, (dir / "up.log").string());
+  test::ChildProcess twin({TWIN_EXE, "--domain", domain, "--order", "doomed", "--product", product, "--out",
+                           (dir / "doomed").string(), "--lease", "0.5"},
+                          (dir / "doomed.log").string());
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (read_text(dir / "doomed.log").find("virtual assembly: 3 of") == std::string::npos &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  REQUIRE(read_text(dir / "doomed.log").find("virtual assembly: 3 of") != std::string::npos);
+  twin.kill_hard();  // three virtual parts stay behind in cell-sim, the station stays reserved
+
+  // The next order needs the station and the same place in cell-sim.
+  const int code = cellctl({"submit", product, "--domain", domain, "--order", "next", "--out", (dir / "next").string()},
+                           dir / "next.log");
+  const std::string log = read_text(dir / "next.log");
+  INFO(log << read_text(dir / "up.log"));
+  CHECK(code == 0);
+  CHECK(log.find("doomed") == std::string::npos);  // nothing of the dead order in the way
+  CHECK(cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
