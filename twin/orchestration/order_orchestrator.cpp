@@ -248,17 +248,45 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
   emit("FINDING", {{"kind", std::string("collision")},
                    {"message", name + " along '" + all[candidate_].label + "' in cell-sim: " + reason},
                    {"part", name}});
-  if (++candidate_ >= all.size()) {
-    return fail("virtual assembly found no collision-free path for " + name + " in cell-sim (" +
-                std::to_string(all.size()) + " tried)");
-  }
   actions_.clear();
   action_running_ = false;
   const std::string body = virtual_body(part);
   actions_.push_back({Action::command, command(awarded("translate"), "release", body)});
   actions_.push_back({Action::sim, sim_.remove(body)});
   spawned_.erase(body);
+  if (++candidate_ >= all.size()) return back_to_sequence_planning();
   add_candidate(step_, candidate_);
+  next_action();
+}
+
+void OrderOrchestrator::back_to_sequence_planning() {
+  const PartIndex part = plan_.steps[step_].part;
+  const std::string& name = product_.product.parts()[part].name;
+  barred_.erase(barred_.upper_bound(step_), barred_.end());
+  barred_[step_].insert(part);
+  PlannerOptions options;
+  options.given.assign(plan_.steps.begin(), plan_.steps.begin() + step_);
+  for (std::size_t i = 0; i < step_; ++i) options.given[i].trajectory = validated_[i];
+  options.not_next = barred_[step_];
+  SearchSequencePlanner sequence;
+  const auto path = make_path_planner(plan_.path_planner);
+  Plan replanned = plan_assembly(product_, sequence, *path, options);
+  std::string barred;
+  for (PartIndex p : barred_[step_]) barred += (barred.empty() ? "" : ", ") + product_.product.parts()[p].name;
+  if (!replanned.complete) {
+    return fail("virtual assembly found no collision-free path in cell-sim for " + name + ", and no other order of " +
+                "the remaining parts works with " + barred + " not next at step " + std::to_string(step_ + 1));
+  }
+  const std::string& next = product_.product.parts()[replanned.steps[step_].part].name;
+  emit("FINDING", {{"kind", std::string("backtrack")},
+                   {"message", "no path in cell-sim for " + name + " at step " + std::to_string(step_ + 1) +
+                                   "; planned again from the " + std::to_string(step_) + " parts in place, " + next +
+                                   " next"},
+                   {"part", name}});
+  replanned.findings = plan_.findings;
+  plan_ = std::move(replanned);
+  candidate_ = 0;
+  add_candidate(step_, 0);
   next_action();
 }
 
@@ -360,6 +388,7 @@ void OrderOrchestrator::next_action() {
   action_running_ = false;
   if (phase_ == "virtual") {
     validated_.push_back(candidates(step_)[candidate_]);
+    plan_.steps[step_].trajectory = validated_.back();
     status("VIRTUAL_ASSEMBLY", "virtual assembly: " + std::to_string(step_ + 1) + " of " +
                                    std::to_string(plan_.steps.size()) + " parts",
            double(step_ + 1) / plan_.steps.size());

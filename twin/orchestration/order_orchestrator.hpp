@@ -9,7 +9,9 @@
 //   VIRTUAL      virtual assembly in cell-sim: each part spawned where its trajectory
 //                starts, gripped, moved, released, the arm backs out, the part connected.
 //                A collision cell-sim reports is answered with the next trajectory the
-//                planner had for that part; none left fails the order.
+//                planner had for that part; none left: back to sequence planning from the
+//                parts assembled so far, with that part barred from coming next (another
+//                order); no order left fails the order.
 //   PHYSICAL     the virtual parts removed; every part spawned at its buffer's dock; the
 //                mobile robot's queue filled with fetches in planned order; for each step the
 //                arm waits for that part's delivery, grips it at the station's dock, carries
@@ -51,8 +53,9 @@ class OrderOrchestrator : public fb::BasicBlock {
  public:
   OrderOrchestrator(std::string name, const LoadedProduct& product, const Plan& plan, OrderSettings settings);
 
-  // The trajectory virtual assembly validated for each step (after any retries).
-  const std::vector<Trajectory>& validated() const { return validated_; }
+  // The plan as virtual assembly left it: the sequence (replanned if cell-sim made it go
+  // back), each step with the trajectory cell-sim validated.
+  const Plan& plan() const { return plan_; }
   const std::string& error() const { return error_; }
 
  private:
@@ -83,6 +86,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   void next_action();
   void action_done();
   void on_collision(const std::string& reason);
+  // No trajectory of the current step's part works in cell-sim: plan the rest again.
+  void back_to_sequence_planning();
   void fail(const std::string& reason);
   void finish();
   void status(const std::string& state, const std::string& message, double progress);
@@ -93,7 +98,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::string physical_body(PartIndex part) const;
 
   const LoadedProduct& product_;
-  const Plan& plan_;
+  Plan plan_;
   AssemblyScene scene_;  // for the gripper's pad size per part and push
   OrderSettings settings_;
   fb::SimRequests sim_;
@@ -107,6 +112,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::size_t step_ = 0, candidate_ = 0;
   std::string phase_;  // "virtual", "physical", "cleanup"
   std::vector<Trajectory> validated_;
+  std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
   std::set<std::string> delivered_, spawned_;
   std::map<std::string, PartIndex> fetch_of_;
   std::string error_;

@@ -148,7 +148,7 @@ class TwinProcess {
     return block;
   }
 
-  int orchestrate(const twin::LoadedProduct& product, twin::Plan& plan, const std::filesystem::path& plan_file) {
+  int orchestrate(const twin::LoadedProduct& product, const twin::Plan& plan, const std::filesystem::path& plan_file) {
     fb::Resource r("twin-" + options_.order, 4096);
     twin::OrderSettings settings;
     settings.order_id = options_.order;
@@ -225,9 +225,10 @@ class TwinProcess {
       status(fb::get<std::string>(d, "state"), fb::get<std::string>(d, "message"), fb::get<double>(d, "progress"));
     }));
     r.connect("orchestrator", "STATUS", "status", "REQ");
-    r.add(std::make_unique<fb::ActionBlock>("findings", [&plan](const fb::Data& d) {
-      plan.findings.push_back({fb::get<std::string>(d, "kind"), fb::get<std::string>(d, "message"),
-                               {fb::get<std::string>(d, "part")}});
+    std::vector<twin::Finding> findings;
+    r.add(std::make_unique<fb::ActionBlock>("findings", [&findings](const fb::Data& d) {
+      findings.push_back({fb::get<std::string>(d, "kind"), fb::get<std::string>(d, "message"),
+                          {fb::get<std::string>(d, "part")}});
       std::cout << "finding: " << fb::get<std::string>(d, "message") << std::endl;  // also when quiet
     }));
     r.connect("orchestrator", "FINDING", "findings", "REQ");
@@ -252,12 +253,13 @@ class TwinProcess {
     }
     if (!finished) return end_with(1, "stopped before the order ended");
 
-    // What the designer gets: the plan with virtual assembly's findings and the validated
-    // trajectories, and the animation of it.
-    for (std::size_t i = 0; i < orchestrator.validated().size(); ++i) plan.steps[i].trajectory = orchestrator.validated()[i];
-    write_plan(product, plan, plan_file);
+    // What the designer gets: the plan as virtual assembly validated it (replanned if cell-sim
+    // made it go back), planning's and virtual assembly's findings, and the animation.
+    twin::Plan validated = orchestrator.plan();
+    validated.findings.insert(validated.findings.end(), findings.begin(), findings.end());
+    write_plan(product, validated, plan_file);
     const auto animation = plan_file.parent_path() / "animation.gltf";
-    twin::write_gltf_animation(product, plan, animation);
+    twin::write_gltf_animation(product, validated, animation);
     if (!orchestrator.error().empty()) return end_with(1, orchestrator.error(), plan_file.string(), true);
     result(true, plan_file.string(), animation.string(), "");
     linger();

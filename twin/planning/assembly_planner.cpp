@@ -29,6 +29,11 @@ class Search {
   Plan run() {
     plan_.sequence_planner = sequence_.name();
     plan_.path_planner = path_.name();
+    for (const PlanStep& step : options_.given) {
+      assembled_[step.part] = true;
+      scene_.assemble(step.part);
+      plan_.steps.push_back(step);
+    }
     plan_.complete = extend();
     if (!plan_.complete && deepest_.size() > plan_.steps.size()) plan_.steps = deepest_;
     report();
@@ -44,6 +49,7 @@ class Search {
     if (failed_states_.count(assembled_)) return false;
     const std::vector<PartIndex> allowed(scene_.frontier().begin(), scene_.frontier().end());
     for (PartIndex part : sequence_.candidates(scene_)) {
+      if (plan_.steps.size() == options_.given.size() && options_.not_next.count(part)) continue;
       std::vector<Attempt> tried;
       std::optional<Trajectory> trajectory;
       while ((trajectory = path_.next(scene_, part, tried))) {

@@ -5,6 +5,7 @@
 // another order (if the sequence planner backtracks). The result is a plan and findings
 // for the designer.
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,11 @@ struct Plan {
 
 struct PlannerOptions {
   std::size_t max_backtracks = 10000;  // bounds the search on products that cannot be built
+  // Planning on from a partial assembly (virtual assembly has done these steps; they stand),
+  // with `not_next` barred from being the next part after them (cell-sim found no path for
+  // it there): the twin's way back to sequence planning.
+  std::vector<PlanStep> given;
+  std::set<PartIndex> not_next;
   sim::CollisionOptions collision;
   ArmGeometry arm;
 };
