@@ -114,10 +114,12 @@ int submit(const CellConfig& cell, SubmitOptions o, CellObserver& observer, doub
   observer.on_status([order = o.order](const cell::OrderStatus& s) {
     if (s.order_id() == order) print_progress(s);
   });
-  Process twin("twin-" + o.order, {executable_dir() + "/twin", "--domain", std::to_string(cell.domain), "--order",
-                                   o.order, "--product", o.product, "--out", o.out, "--sequence", o.sequence, "--path",
-                                   o.path, "--wait", std::to_string(wait_s), "--lease",
-                                   std::to_string(cell.liveliness_lease), "--quiet"});
+  std::vector<std::string> argv{executable_dir() + "/twin", "--domain", std::to_string(cell.domain), "--order", o.order,
+                                "--product", o.product, "--out", o.out, "--sequence", o.sequence, "--path", o.path,
+                                "--wait", std::to_string(wait_s), "--lease", std::to_string(cell.liveliness_lease),
+                                "--quiet"};
+  if (!cell.localhost_only) argv.push_back("--all-interfaces");
+  Process twin("twin-" + o.order, argv);
   while (twin.poll() < 0) {
     if (stop_requested) twin.stop();
     std::this_thread::sleep_for(20ms);
@@ -144,7 +146,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     const CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
-    CellObserver observer(cell.domain);
+    CellObserver observer(cell.domain, cell.localhost_only);
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n';
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size()
@@ -168,7 +170,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
     const CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
-    CellObserver observer(cell.domain);
+    CellObserver observer(cell.domain, cell.localhost_only);
     exit_code = submit(cell, *submit_options, observer, cell_options->wait_s);
   });
 
@@ -176,7 +178,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   add_cell_options(status, *cell_options);
   status->callback([cell_options] {
     const CellConfig cell = cell_options->load();
-    CellObserver observer(cell.domain);
+    CellObserver observer(cell.domain, cell.localhost_only);
     observer.wait_for_resources(cell.resource_ids(), 2s);
     std::this_thread::sleep_for(300ms);  // orders and resources outside the file
     TextTable resources({"resource", "kind", "state", "work", "reserved by", "stock"});
@@ -223,7 +225,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     const CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
-    CellObserver observer(cell.domain);
+    CellObserver observer(cell.domain, cell.localhost_only);
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));

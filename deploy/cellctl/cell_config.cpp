@@ -64,10 +64,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   if (!root.IsMap()) throw ConfigError(file.string() + ": a cell is a map of keys");
   CellConfig c;
   c.file = file;
-  known_keys(file, root, {"domain", "real_time_factor", "liveliness_lease", "station", "mobile_robot", "buffers"});
+  known_keys(file, root,
+             {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "mobile_robot", "buffers"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
+  read(file, root, "localhost_only", c.localhost_only);
   if (c.domain < 0 || c.domain > 232) throw ConfigError(where(file, root["domain"]) + ": domain must be 0..232");
   if (c.real_time_factor <= 0) throw ConfigError(where(file, root["real_time_factor"]) + ": must be above 0");
   if (const auto s = root["station"]) {
@@ -126,6 +128,9 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
       buffer.argv.push_back(type + "=" + std::to_string(count));
     }
     out.push_back(buffer);
+  }
+  if (!c.localhost_only) {
+    for (auto& p : out) p.argv.push_back("--all-interfaces");
   }
   return out;
 }

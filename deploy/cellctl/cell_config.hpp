@@ -23,6 +23,7 @@ struct CellConfig {
   int domain = 42;
   double real_time_factor = 1;
   double liveliness_lease = 1;
+  bool localhost_only = true;  // false: every process uses every network interface
   std::string station = "station-1", arm = "arm-1";
   Point station_position{}, dock{0.6, 0, 0}, table{1.0, 0.025, 1.0};
   double arm_speed = 0.25, arm_angular_speed = 1.0;

@@ -21,8 +21,8 @@ struct CellObserver::Impl {
   std::unique_ptr<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>> events;
 };
 
-CellObserver::CellObserver(int domain) : impl_(std::make_unique<Impl>()) {
-  impl_->participant = dds::make_participant("cellctl", {domain, true});
+CellObserver::CellObserver(int domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
+  impl_->participant = dds::make_participant("cellctl", {domain, localhost_only});
   const auto changed = [this](auto&& f) {
     {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -25,7 +25,7 @@ struct ResourceView {
 
 class CellObserver {
  public:
-  explicit CellObserver(int domain);
+  CellObserver(int domain, bool localhost_only);
   ~CellObserver();
 
   // Writes every command event (and every delivery) as one JSON line to `file` from now on.

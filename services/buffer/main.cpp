@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "services/buffer/buffer_service.hpp"
+#include "services/dds/cli_options.hpp"
 
 namespace {
 volatile std::sig_atomic_t running = 1;
@@ -19,12 +20,14 @@ int main(int argc, char** argv) {
   services::BufferConfig config;
   std::vector<std::string> stock;
   app.add_option("--id", config.node.id, "Resource id")->required();
-  app.add_option("--domain", config.dds.domain_id, "DDS domain id")->required();
+  bool all_interfaces = false;
+  dds::add_dds_options(app, config.dds, all_interfaces);
   app.add_option("--stock", stock, "TYPE=COUNT, repeatable");
   app.add_option("--position", config.node.position, "Where it stands: x y z, m");
   app.add_option("--lease", config.node.liveliness_lease_s, "Liveliness lease of the capability, s");
   try {
     app.parse(argc, argv);
+    dds::apply_interfaces(config.dds, all_interfaces);
     for (const auto& s : stock) {
       const auto eq = s.find('=');
       if (eq == std::string::npos) throw CLI::ValidationError("--stock", "expected TYPE=COUNT, got " + s);

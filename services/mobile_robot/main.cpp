@@ -10,6 +10,7 @@
 
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
+#include "services/dds/cli_options.hpp"
 #include "services/dds/conversions.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "services/mobile_robot/mobile_robot_block.hpp"
@@ -27,12 +28,14 @@ int main(int argc, char** argv) {
   services::NodeConfig config{"mobile-robot-1", "mobile-robot"};
   config.speed = 0.8;
   config.when_busy = fb::CommandLifecycle::WhenBusy::queue;
-  app.add_option("--domain", dds.domain_id, "DDS domain id")->required();
+  bool all_interfaces = false;
+  dds::add_dds_options(app, dds, all_interfaces);
   app.add_option("--id", config.id, "Resource id");
   app.add_option("--home", config.position, "Where it waits: x y z, m");
   app.add_option("--speed", config.speed, "m/s")->check(CLI::PositiveNumber);
   app.add_option("--lease", config.liveliness_lease_s, "Liveliness lease of the capability, s");
   CLI11_PARSE(app, argc, argv);
+  dds::apply_interfaces(dds, all_interfaces);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   try {

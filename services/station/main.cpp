@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "services/dds/cli_options.hpp"
 #include "services/node/resource_node.hpp"
 #include "services/node/run.hpp"
 #include "services/station/arm_block.hpp"
@@ -24,7 +25,8 @@ int main(int argc, char** argv) {
   services::NodeConfig station{"station-1", "station"}, arm{"arm-1", "arm"};
   std::array<double, 3> table{1.0, 0.025, 1.0};
   fb::ArmSettings arm_settings;
-  app.add_option("--domain", dds.domain_id, "DDS domain id")->required();
+  bool all_interfaces = false;
+  dds::add_dds_options(app, dds, all_interfaces);
   app.add_option("--id", station.id, "Resource id of the station");
   app.add_option("--arm-id", arm.id, "Resource id of its arm");
   app.add_option("--position", station.position, "The assembly point on the table's top: x y z, m");
@@ -34,6 +36,7 @@ int main(int argc, char** argv) {
   app.add_option("--arm-angular-speed", arm_settings.angular_speed, "rad/s")->check(CLI::PositiveNumber);
   app.add_option("--lease", station.liveliness_lease_s, "Liveliness lease of the capabilities, s");
   CLI11_PARSE(app, argc, argv);
+  dds::apply_interfaces(dds, all_interfaces);
   arm.position = station.position;
   arm.dock = station.dock;
   arm.speed = arm_settings.speed;

@@ -9,11 +9,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "ordersPubSubTypes.h"
+#include "services/blocks/order_watch.hpp"
+#include "services/dds/cli_options.hpp"
 #include "services/dds/conversions.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "sim/cell_sim/world_block.hpp"
-#include "ordersPubSubTypes.h"
-#include "services/blocks/order_watch.hpp"
 #include "simulationPubSubTypes.h"
 
 namespace {
@@ -26,10 +27,12 @@ int main(int argc, char** argv) {
   dds::ParticipantSettings settings;
   double factor = 1.0;
   bool verbose = false;
-  app.add_option("--domain", settings.domain_id, "DDS domain id")->required();
+  bool all_interfaces = false;
+  dds::add_dds_options(app, settings, all_interfaces);
   app.add_option("--real-time-factor", factor, "Sim seconds per wall second")->check(CLI::PositiveNumber);
   app.add_flag("--verbose", verbose, "Print every request and reply");
   CLI11_PARSE(app, argc, argv);
+  dds::apply_interfaces(settings, all_interfaces);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   try {

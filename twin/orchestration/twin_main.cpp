@@ -18,6 +18,7 @@
 #include "negotiationPubSubTypes.h"
 #include "ordersPubSubTypes.h"
 #include "services/blocks/action_block.hpp"
+#include "services/dds/cli_options.hpp"
 #include "services/dds/conversions.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "services/dds/sim_clock.hpp"
@@ -279,7 +280,8 @@ class TwinProcess {
 int main(int argc, char** argv) {
   CLI::App app{"twin: the digital twin of one order"};
   Options o;
-  app.add_option("--domain", o.dds.domain_id, "DDS domain id")->required();
+  bool all_interfaces = false;
+  dds::add_dds_options(app, o.dds, all_interfaces);
   app.add_option("--order", o.order, "Order id")->required();
   app.add_option("--product", o.product, "The product's AutomationML file")->required();
   app.add_option("--out", o.out, "Folder for plan.json and animation.gltf");
@@ -290,6 +292,7 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
   app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
   CLI11_PARSE(app, argc, argv);
+  dds::apply_interfaces(o.dds, all_interfaces);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   try {
