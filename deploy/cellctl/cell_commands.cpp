@@ -142,6 +142,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
 
   CLI::App* up = app.add_subcommand("up", "Start the cell of a deployment file and supervise it");
   add_cell_options(up, *cell_options);
+  up->add_option("CELL", cell_options->cell, "Deployment file (the same as --cell)")->check(CLI::ExistingFile);
   up->callback([cell_options, &exit_code] {
     const CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);

@@ -4,7 +4,7 @@
 
 namespace cellctl {
 
-// cellctl up [--cell CELL.yaml]        starts and supervises the cell until `down` or Ctrl-C
+// cellctl up [CELL.yaml]               starts and supervises the cell until `down` or Ctrl-C
 // cellctl submit PRODUCT.aml           spawns a twin for the order and follows it to its end
 // cellctl status                       resources (alive, reserved by) and orders
 // cellctl down                         stops the cell `up` started
