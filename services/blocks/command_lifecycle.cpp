@@ -1,5 +1,7 @@
 #include "services/blocks/command_lifecycle.hpp"
 
+#include <algorithm>
+
 namespace fb {
 
 CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : BasicBlock(std::move(name), "IDLE") {
@@ -45,6 +47,17 @@ CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : Basic
     emit("CANCELING", with_id({}));
     emit("STOP", with_id({}));
   }, is_current);
+  // A command still waiting in the queue is simply taken out.
+  const auto is_queued = [this](const Data& d) {
+    return std::find(queue_.begin(), queue_.end(), get<std::string>(d, "command_id")) != queue_.end();
+  };
+  for (const char* busy : {"EXECUTING", "CANCELING"}) {
+    transition(busy, "CANCEL", busy, [this](const Data& d) {
+      const std::string& id = get<std::string>(d, "command_id");
+      queue_.erase(std::find(queue_.begin(), queue_.end(), id));
+      emit("CANCELED", {{"command_id", id}});
+    }, is_queued);
+  }
   transition("CANCELING", "STOPPED", "IDLE", [this](const Data&) { emit("CANCELED", with_id({})); }, queue_is_empty);
   transition("CANCELING", "STOPPED", "EXECUTING", [this](const Data&) {
     emit("CANCELED", with_id({}));

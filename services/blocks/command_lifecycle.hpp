@@ -15,6 +15,8 @@
 //   STOPPED                        CANCELING, STOP       (command_id)
 //                                  CANCELED              (command_id)
 //                                  REJECTED              (command_id, reason)
+// CANCEL of a queued command takes it out at once (CANCELED); of the executing one, asks the
+// device to STOP (a device that finishes first: its outcome stands).
 // Data the device adds to PROGRESS, DONE and FAIL (a sim time, a distance) goes out with
 // the event they cause.
 

@@ -105,6 +105,10 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   n.subscribe<cell::Command, cell::CommandPubSubType>("commands", "cell/commands", TopicKind::events,
                                                      [](const cell::Command& c) { return dds::to_data(c); });
   resource.connect("commands", "IND", dev, "COMMAND");
+  n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
+      "cancels", "cell/cancel_requests", TopicKind::events,
+      [](const cell::CancelRequest& c) { return fb::Data{{"command_id", c.command_id()}}; });
+  resource.connect("cancels", "IND", "lifecycle", "CANCEL");
   resource.connect(dev, "ACCEPT", "lifecycle", "COMMAND");
   resource.connect("lifecycle", "START", dev, "START");
   for (const char* e : {"PROGRESS", "DONE", "FAIL"}) resource.connect(dev, e, "lifecycle", e);

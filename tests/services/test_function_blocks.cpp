@@ -211,3 +211,16 @@ TEST_CASE("contractor: a shared resource confirms every order, and a release fre
             "RELEASE", {{"order_id", std::string("o1")}, {"resource_id", std::string("arm-1")}})) == Names{"RESERVED"});
   CHECK(exclusive.block().reserved_by().empty());
 }
+
+TEST_CASE("command life cycle with a queue: a queued command is canceled at once", "[fb][lifecycle]") {
+  fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle", fb::CommandLifecycle::WhenBusy::queue);
+  f.send("COMMAND", {{"command_id", std::string("c1")}});
+  f.send("COMMAND", {{"command_id", std::string("c2")}});
+  f.send("COMMAND", {{"command_id", std::string("c3")}});
+  const auto canceled = f.send("CANCEL", {{"command_id", std::string("c2")}});
+  REQUIRE(names<fb::CommandLifecycle>(canceled) == Names{"CANCELED"});
+  CHECK(fb::get<std::string>(canceled[0].data, "command_id") == "c2");
+  const auto next = f.send("DONE");
+  REQUIRE(names<fb::CommandLifecycle>(next) == Names{"SUCCEEDED", "START"});
+  CHECK(fb::get<std::string>(next[1].data, "command_id") == "c3");  // c2 is gone
+}

@@ -16,13 +16,15 @@ using fb::get;
 
 struct Outcome {
   std::vector<std::string> findings;  // kinds
+  std::vector<std::string> canceled;  // command ids
   std::vector<std::string> spawned;   // bodies, in order
   bool finished = false, complete = false;
   std::string error;
 };
 
 // Runs an order against a cell that answers everything at once; `refuse(command)` returns a
-// reason to abort a command with (empty: it succeeds).
+// reason to abort a command with (empty: it succeeds; kNoAnswer: it is never answered).
+const std::string kNoAnswer = "(no answer)";
 Outcome run(fb::BlockTestFixture<twin::OrderOrchestrator>& f, const std::function<std::string(const Data&)>& refuse) {
   Outcome out;
   for (const char* id : {"station-1", "arm-1", "mobile-robot-1", "buffer-1"}) {
@@ -48,9 +50,12 @@ Outcome run(fb::BlockTestFixture<twin::OrderOrchestrator>& f, const std::functio
                                   {"collided", false}});
     } else if (e.name == "COMMAND") {
       const std::string reason = refuse(e.data);
+      if (reason == kNoAnswer) continue;
       more = f.send("COMMAND_EVENT", {{"command_id", e.data.at("command_id")}, {"order_id", e.data.at("order_id")},
                                       {"state", std::string(reason.empty() ? "succeeded" : "aborted")},
                                       {"reason", reason}});
+    } else if (e.name == "CANCEL") {
+      out.canceled.push_back(get<std::string>(e.data, "command_id"));
     } else if (e.name == "FINDING") {
       out.findings.push_back(get<std::string>(e.data, "kind"));
     } else if (e.name == "FINISHED") {
@@ -118,4 +123,33 @@ TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, w
   CHECK(out.error.find("no collision-free path in cell-sim for hanging") != std::string::npos);
   // What it had spawned left cell-sim again.
   CHECK(f.block().state() == "ENDED");
+}
+
+TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {
+  sim::MeshCache meshes;
+  const twin::LoadedProduct product = twin::load_product(std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", meshes);
+  twin::SearchSequencePlanner sequence;
+  const auto path = twin::make_path_planner("linear");
+  const twin::Plan plan = twin::plan_assembly(product, sequence, *path);
+  twin::OrderSettings settings;
+  settings.order_id = "o1";
+  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", product, plan, settings);
+  // The robot delivers the first two parts; the arm cannot grip the second.
+  int fetches = 0, physical_grips = 0;
+  std::vector<std::string> unanswered;
+  const Outcome out = run(f, [&](const Data& c) -> std::string {
+    const std::string& op = get<std::string>(c, "operation");
+    if (op == "fetch" && ++fetches > 2) {
+      unanswered.push_back(get<std::string>(c, "command_id"));
+      return kNoAnswer;
+    }
+    const bool physical = get<std::string>(c, "part").find("/virtual/") == std::string::npos;
+    if (op == "grip" && physical && ++physical_grips == 2) return "gripper jammed";
+    return "";
+  });
+  CHECK(out.finished);
+  CHECK_FALSE(out.complete);
+  CHECK(out.error.find("gripper jammed") != std::string::npos);
+  CHECK(out.canceled == unanswered);
+  CHECK(unanswered.size() == plan.steps.size() - 2);
 }

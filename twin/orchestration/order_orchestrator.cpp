@@ -35,7 +35,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_input("AWARD_REPLY", {"call_id", "resource_id", "confirmed", "reason"});
   declare_input("COMMAND_EVENT", {"command_id", "order_id", "state", "reason"});
   declare_input("SIM_REPLY", {"request_id", "ok", "error", "collided"});
-  for (const char* out : {"CFP", "AWARD", "RELEASE", "COMMAND", "SIM"}) declare_output(out);
+  for (const char* out : {"CFP", "AWARD", "RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
   declare_output("FINISHED", {"complete", "error"});
@@ -424,6 +424,10 @@ void OrderOrchestrator::action_done() {
 void OrderOrchestrator::fail(const std::string& reason) {
   if (!error_.empty()) return;
   error_ = reason;
+  // The mobile robot need not fetch what will not be assembled.
+  for (const auto& [fetch, part] : fetch_of_) {
+    if (!delivered_.count(fetch)) emit("CANCEL", {{"command_id", fetch}});
+  }
   if (state() == "NEGOTIATING" || state() == "IDLE") return finish();
   enter("RUNNING");
   plan_cleanup();

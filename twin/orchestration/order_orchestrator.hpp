@@ -26,7 +26,8 @@
 //           (resource_id), PROPOSAL (call_id, resource_id), AWARD_REPLY (call_id,
 //           resource_id, confirmed, reason), COMMAND_EVENT (command_id, order_id, state,
 //           reason), SIM_REPLY (request_id, ok, error, collided, ...)
-//   outputs: CFP, AWARD, RELEASE, COMMAND, SIM (the topics' fields), STATUS (state, message,
+//   outputs: CFP, AWARD, RELEASE, COMMAND, CANCEL (fetches not delivered when the order
+//            fails), SIM (the topics' fields), STATUS (state, message,
 //            progress), FINDING (kind, message, part), FINISHED (complete, error)
 
 #include <chrono>

@@ -216,6 +216,12 @@ class TwinProcess {
       if (options_.verbose) std::cout << "  command " << c.command_id() << " to " << c.resource_id() << std::endl;
       return c;
     });
+    publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "CANCEL",
+                                                                [](const fb::Data& d) {
+                                                                  cell::CancelRequest c;
+                                                                  c.command_id(fb::get<std::string>(d, "command_id"));
+                                                                  return c;
+                                                                });
     auto& sim = publish<cell::SimRequest, cell::SimRequestPubSubType>(
         r, "sim_requests", "cell/sim/requests", "SIM", [this](const fb::Data& d) {
           if (options_.verbose) std::cout << "  sim " << fb::get<std::string>(d, "request_id") << " "
