@@ -67,7 +67,7 @@ class RunningCell {
   ~RunningCell() { stop(); }
 
   // A process that ended by itself, or nullptr.
-  const Process* ended() {
+  Process* ended() {
     for (auto& p : processes_) {
       if (p->poll() >= 0) return p.get();
     }
@@ -153,8 +153,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size()
               << " resources); `cellctl down --domain " << cell.domain << "` stops it" << std::endl;
     while (!stop_requested) {
-      if (const Process* p = running.ended()) {
-        std::cerr << "error: " << p->name() << " ended (exit " << const_cast<Process*>(p)->poll() << "); stopping the cell\n";
+      if (Process* p = running.ended()) {
+        std::cerr << "error: " << p->name() << " ended (exit " << p->poll() << "); stopping the cell\n";
         exit_code = 1;
         break;
       }

@@ -1,6 +1,5 @@
 #include "services/dds/conversions.hpp"
 
-#include <sstream>
 #include <stdexcept>
 
 namespace dds {
@@ -40,21 +39,6 @@ cell::Vec3 vec3(double x, double y, double z) {
   v.y(y);
   v.z(z);
   return v;
-}
-
-std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ",") + n;
-  return out;
-}
-
-std::vector<std::string> split(const std::string& joined) {
-  std::vector<std::string> out;
-  std::stringstream in(joined);
-  for (std::string item; std::getline(in, item, ',');) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
 }
 
 }  // namespace dds
@@ -119,7 +103,7 @@ cell::SimRequest to_sim_request(const fb::Data& d) {
   if (placement.size() != 1) throw std::invalid_argument("a placement is one pose");
   r.placement(placement.front());
   r.is_static(fb::get_or<bool>(d, "is_static", false));
-  r.carried(split(text("carried")));
+  r.carried(fb::split_names(text("carried")));
   r.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
   r.speed(fb::get_or<double>(d, "speed", 0));
   r.angular_speed(fb::get_or<double>(d, "angular_speed", 0));
@@ -139,7 +123,7 @@ fb::Data to_data(const cell::SimRequest& r) {
           {"half_extents", to_numbers(r.half_extents())},
           {"placement", to_numbers(std::vector<cell::Pose>{r.placement()})},
           {"is_static", r.is_static()},
-          {"carried", join(r.carried())},
+          {"carried", fb::join_names(r.carried())},
           {"path", to_numbers(r.path())},
           {"speed", r.speed()},
           {"angular_speed", r.angular_speed()}};

@@ -1,6 +1,6 @@
 #pragma once
 // Between DDS value types and event data: a pose is seven numbers (x, y, z, qw, qx, qy, qz),
-// a path seven per waypoint, a list of names one comma-separated string.
+// a path seven per waypoint, a list of names one comma-separated string (fb::join_names).
 
 #include <string>
 #include <vector>
@@ -15,9 +15,6 @@ std::vector<cell::Pose> to_path(const fb::Numbers& numbers);  // throws std::inv
 fb::Numbers to_numbers(const cell::Vec3& v);
 cell::Vec3 to_vec3(const fb::Numbers& numbers);  // throws std::invalid_argument unless three numbers
 cell::Vec3 vec3(double x, double y, double z);
-
-std::string join(const std::vector<std::string>& names);
-std::vector<std::string> split(const std::string& joined);
 
 }  // namespace dds
 

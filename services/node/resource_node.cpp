@@ -3,10 +3,9 @@
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "negotiationPubSubTypes.h"
-#include "ordersPubSubTypes.h"
 #include "services/blocks/action_block.hpp"
-#include "services/blocks/order_watch.hpp"
 #include "services/dds/conversions.hpp"
+#include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "simulationPubSubTypes.h"
 
@@ -42,7 +41,6 @@ struct ResourceNode::Impl {
   Pub<cell::SimRequest, cell::SimRequestPubSubType>* sim_requests = nullptr;
   fb::CommandLifecycle* lifecycle = nullptr;
   bool busy = false;  // as last published
-  std::function<void()> publish_capability;
 
   Impl(fb::Resource& r, dds::ParticipantPtr p, NodeConfig c, fb::DeviceBlock& d)
       : resource(r), participant(p), config(std::move(c)), device(d), clock(p) {}
@@ -57,6 +55,22 @@ struct ResourceNode::Impl {
   template <class T, class P>
   void publish(const std::string& name, const std::string& topic, typename Pub<T, P>::ToSample to_sample) {
     resource.add(std::make_unique<Pub<T, P>>(name, participant, topic, TopicKind::events, std::move(to_sample)));
+  }
+
+  void publish_capability() const {
+    cell::Capability c;
+    c.resource_id(config.id);
+    c.kind(config.kind);
+    c.operations(std::vector<std::string>(device.operations().begin(), device.operations().end()));
+    c.position(dds::vec3(config.position[0], config.position[1], config.position[2]));
+    c.dock(dds::vec3(config.dock[0], config.dock[1], config.dock[2]));
+    c.reach(config.reach);
+    c.speed(config.speed);
+    c.angular_speed(config.angular_speed);
+    c.reserved_by(contractor->reserved_by());
+    c.busy(busy);
+    if (describe) describe(c);
+    capabilities->write(c);
   }
 
   cell::CommandEvent event_of(cell::CommandState state, const fb::Data& d) {
@@ -77,11 +91,8 @@ struct ResourceNode::Impl {
     if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
     e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
     if (is_final(state)) device.forget(id);
-    if (lifecycle->state() != "IDLE" && !busy) {
-      busy = true;
-      publish_capability();
-    } else if (lifecycle->state() == "IDLE" && busy) {
-      busy = false;
+    if ((lifecycle->state() != "IDLE") != busy) {
+      busy = !busy;
       publish_capability();
     }
     return e;
@@ -101,7 +112,6 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   // Commands and their life cycle.
   const std::string dev = device.name();
   n.lifecycle = &resource.add(std::make_unique<fb::CommandLifecycle>("lifecycle", n.config.when_busy));
-  n.publish_capability = [this] { publish_capability(); };
   n.subscribe<cell::Command, cell::CommandPubSubType>("commands", "cell/commands", TopicKind::events,
                                                      [](const cell::Command& c) { return dds::to_data(c); });
   resource.connect("commands", "IND", dev, "COMMAND");
@@ -139,16 +149,11 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
                                                         return fb::Data{{"order_id", r.order_id()},
                                                                         {"resource_id", r.resource_id()}};
                                                       });
-  n.subscribe<cell::OrderStatus, cell::OrderStatusPubSubType>(
-      "orders", "cell/orders/status", TopicKind::state, [](const cell::OrderStatus& s) {
-        return fb::Data{{"order_id", s.order_id()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
-      });
-  resource.add(std::make_unique<fb::OrderWatch>());
+  auto& orders = dds::watch_orders(resource, participant);
+  n.starters.push_back([&orders] { orders.start(); });
   resource.connect("calls", "IND", "contractor", "CFP");
   resource.connect("awards", "IND", "contractor", "AWARD");
   resource.connect("releases", "IND", "contractor", "RELEASE");
-  resource.connect("orders", "IND", "order_watch", "STATUS");
-  resource.connect("orders", "GONE", "order_watch", "GONE");
   resource.connect("order_watch", "ENDED", "contractor", "ORDER_ENDED");
   resource.connect("order_watch", "ENDED", dev, "ORDER_ENDED");
   resource.connect("order_watch", "ACTIVE", dev, "ORDER_ACTIVE");
@@ -203,21 +208,6 @@ void ResourceNode::start(std::chrono::milliseconds wait_for_sim) {
 
 dds::SimClock& ResourceNode::clock() { return impl_->clock; }
 
-void ResourceNode::publish_capability() {
-  const Impl& n = *impl_;
-  cell::Capability c;
-  c.resource_id(n.config.id);
-  c.kind(n.config.kind);
-  c.operations(std::vector<std::string>(n.device.operations().begin(), n.device.operations().end()));
-  c.position(dds::vec3(n.config.position[0], n.config.position[1], n.config.position[2]));
-  c.dock(dds::vec3(n.config.dock[0], n.config.dock[1], n.config.dock[2]));
-  c.reach(n.config.reach);
-  c.speed(n.config.speed);
-  c.angular_speed(n.config.angular_speed);
-  c.reserved_by(n.contractor->reserved_by());
-  c.busy(n.busy);
-  if (n.describe) n.describe(c);
-  n.capabilities->write(c);
-}
+void ResourceNode::publish_capability() { impl_->publish_capability(); }
 
 }  // namespace services

@@ -26,9 +26,7 @@ Data SimRequests::set_static(const std::string& body, bool is_static) {
 Data SimRequests::move(const std::string& body, const std::vector<std::string>& carried, const Numbers& path,
                        double speed, double angular_speed) {
   Data d = request("move", body);
-  std::string joined;
-  for (const auto& c : carried) joined += (joined.empty() ? "" : ",") + c;
-  d["carried"] = joined;
+  d["carried"] = join_names(carried);
   d["path"] = path;
   d["speed"] = speed;
   d["angular_speed"] = angular_speed;

@@ -22,6 +22,10 @@ struct Event {
 // data["x"] as T; throws std::invalid_argument naming the key when missing or of another type.
 template <class T>
 const T& get(const Data& data, const std::string& key);
+// A list of names travels as one comma-separated string ("a,b,c").
+std::string join_names(const std::vector<std::string>& names);
+std::vector<std::string> split_names(const std::string& joined);
+
 // data["x"] as T, or `fallback` when missing.
 template <class T>
 T get_or(const Data& data, const std::string& key, T fallback);

@@ -1,6 +1,6 @@
 #include "services/station/arm_block.hpp"
 
-#include <cmath>
+#include <Eigen/Geometry>
 
 namespace fb {
 
@@ -78,23 +78,16 @@ void ArmBlock::grip(const Data& d) {
   const Numbers& push = get<Numbers>(d, "direction");
   // The carriage runs behind the pad, against the push, along its main axis.
   int axis = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (std::abs(push[i]) > std::abs(push[axis])) axis = i;
-  }
+  Eigen::Vector3d(push[0], push[1], push[2]).cwiseAbs().maxCoeff(&axis);
   const double sign = push[axis] > 0 ? 1.0 : -1.0;
   Numbers carriage_half(3, settings_.carriage_width / 2);
   carriage_half[axis] = settings_.carriage_length / 2;
-  Numbers offset{0, 0, 0};
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
   offset[axis] = -sign * (size[axis] + settings_.carriage_length / 2);
   // The offset is in the pad's frame: turn it by the pad's orientation.
-  const double w = pose[3], x = pose[4], y = pose[5], z = pose[6];
-  const double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
-                          {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
-                          {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+  offset = Eigen::Quaterniond(pose[3], pose[4], pose[5], pose[6]).normalized() * offset;
   Numbers carriage_pose = pose;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) carriage_pose[r] += R[r][c] * offset[c];
-  }
+  for (int i = 0; i < 3; ++i) carriage_pose[i] += offset[i];
   awaited_ = 2;
   if (has_gripper_) {
     awaited_ += 2;

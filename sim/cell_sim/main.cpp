@@ -9,10 +9,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "ordersPubSubTypes.h"
-#include "services/blocks/order_watch.hpp"
 #include "services/dds/cli_options.hpp"
 #include "services/dds/conversions.hpp"
+#include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "sim/cell_sim/world_block.hpp"
 #include "simulationPubSubTypes.h"
@@ -59,13 +58,7 @@ int main(int argc, char** argv) {
           c.real_time_factor(fb::get<double>(d, "real_time_factor"));
           return c;
         }));
-    auto& orders = resource.add(std::make_unique<dds::SubscribeBlock<cell::OrderStatus, cell::OrderStatusPubSubType>>(
-        "orders", participant, "cell/orders/status", dds::TopicKind::state, [](const cell::OrderStatus& s) {
-          return fb::Data{{"order_id", s.order_id()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
-        }));
-    resource.add(std::make_unique<fb::OrderWatch>());
-    resource.connect("orders", "IND", "order_watch", "STATUS");
-    resource.connect("orders", "GONE", "order_watch", "GONE");
+    auto& orders = dds::watch_orders(resource, participant);
     resource.connect("order_watch", "ENDED", "world", "ORDER_ENDED");
     resource.connect("requests", "IND", "world", "REQUEST");
     resource.connect("world", "REPLY", "replies", "REQ");

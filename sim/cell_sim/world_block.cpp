@@ -19,17 +19,6 @@ std::vector<Pose> poses(const fb::Numbers& n) {
   return out;
 }
 
-std::vector<std::string> names(const std::string& joined) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start < joined.size()) {
-    const std::size_t comma = std::min(joined.find(',', start), joined.size());
-    if (comma > start) out.push_back(joined.substr(start, comma - start));
-    start = comma + 1;
-  }
-  return out;
-}
-
 }  // namespace
 
 WorldBlock::WorldBlock(std::string name, double real_time_factor, double clock_period_s)
@@ -77,7 +66,7 @@ void WorldBlock::handle(const fb::Data& d) {
     } else if (kind == "set_static" || kind == "set_movable") {
       world_.set_static(id, kind == "set_static");
     } else if (kind == "move") {
-      const MoveResult r = world_.move({id, names(fb::get<std::string>(d, "carried")),
+      const MoveResult r = world_.move({id, fb::split_names(fb::get<std::string>(d, "carried")),
                                         poses(fb::get<fb::Numbers>(d, "path")), fb::get<double>(d, "speed"),
                                         fb::get<double>(d, "angular_speed")});
       due = start + r.duration;

@@ -68,19 +68,33 @@ Outcome run(fb::BlockTestFixture<twin::OrderOrchestrator>& f, const std::functio
   return out;
 }
 
+// A product from deploy/products, planned (search, linear) as the twin plans it.
+struct Planned {
+  explicit Planned(const std::string& product_file)
+      : product(twin::load_product(std::string(PRODUCTS_DIR) + "/" + product_file, meshes)),
+        plan(plan_of(product)) {}
+  static twin::Plan plan_of(const twin::LoadedProduct& product) {
+    twin::SearchSequencePlanner sequence;
+    return twin::plan_assembly(product, sequence, *twin::make_path_planner("linear"));
+  }
+  static twin::OrderSettings order_o1() {
+    twin::OrderSettings settings;
+    settings.order_id = "o1";
+    return settings;
+  }
+  sim::MeshCache meshes;
+  twin::LoadedProduct product;
+  twin::Plan plan;
+};
+
 }  // namespace
 
 TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequence planning", "[twin][orchestration]") {
-  sim::MeshCache meshes;
-  const twin::LoadedProduct product = twin::load_product(std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", meshes);
-  twin::SearchSequencePlanner sequence;
-  const auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(product, sequence, *path);
+  const Planned cranfield("cranfield/cranfield.aml");
+  const twin::Plan& plan = cranfield.plan;
   REQUIRE(plan.complete);
-  const std::string second = "o1/virtual/" + product.product.parts()[plan.steps[1].part].name;
-  twin::OrderSettings settings;
-  settings.order_id = "o1";
-  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", product, plan, settings);
+  const std::string second = "o1/virtual/" + cranfield.product.product.parts()[plan.steps[1].part].name;
+  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", cranfield.product, plan, Planned::order_o1());
 
   // cell-sim refuses every move of the plan's second part while it would be second.
   int connected = 0;
@@ -106,14 +120,9 @@ TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequenc
 }
 
 TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, with the reason", "[twin][orchestration]") {
-  sim::MeshCache meshes;
-  const twin::LoadedProduct product = twin::load_product(std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", meshes);
-  twin::SearchSequencePlanner sequence;
-  const auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(product, sequence, *path);
-  twin::OrderSettings settings;
-  settings.order_id = "o1";
-  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", product, plan, settings);
+  const Planned lego("lego-tower/lego-tower.aml");
+  const twin::Plan& plan = lego.plan;
+  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", lego.product, plan, Planned::order_o1());
   const Outcome out = run(f, [](const Data& c) -> std::string {
     return get<std::string>(c, "operation") == "translate" && get<std::string>(c, "part") == "o1/virtual/hanging"
                ? "collision of it" : "";
@@ -126,14 +135,9 @@ TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, w
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {
-  sim::MeshCache meshes;
-  const twin::LoadedProduct product = twin::load_product(std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", meshes);
-  twin::SearchSequencePlanner sequence;
-  const auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(product, sequence, *path);
-  twin::OrderSettings settings;
-  settings.order_id = "o1";
-  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", product, plan, settings);
+  const Planned lego("lego-tower/lego-tower.aml");
+  const twin::Plan& plan = lego.plan;
+  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", lego.product, plan, Planned::order_o1());
   // The robot delivers the first two parts; the arm cannot grip the second.
   int fetches = 0, physical_grips = 0;
   std::vector<std::string> unanswered;

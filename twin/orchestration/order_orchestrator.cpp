@@ -265,8 +265,7 @@ void OrderOrchestrator::back_to_sequence_planning() {
   barred_.erase(barred_.upper_bound(step_), barred_.end());
   barred_[step_].insert(part);
   PlannerOptions options;
-  options.given.assign(plan_.steps.begin(), plan_.steps.begin() + step_);
-  for (std::size_t i = 0; i < step_; ++i) options.given[i].trajectory = validated_[i];
+  options.given.assign(plan_.steps.begin(), plan_.steps.begin() + step_);  // validated already
   options.not_next = barred_[step_];
   SearchSequencePlanner sequence;
   const auto path = make_path_planner(plan_.path_planner);
@@ -323,7 +322,7 @@ void OrderOrchestrator::plan_physical() {
   }
   for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
     const PartIndex part = plan_.steps[i].part;
-    const Trajectory& t = validated_[i];
+    const Trajectory& t = plan_.steps[i].trajectory;
     const auto& w = t.waypoints;
     const std::string body = physical_body(part);
     actions_.push_back({Action::await_delivery, {{"command_id", fetches[i]}}});
@@ -387,8 +386,7 @@ void OrderOrchestrator::next_action() {
   }
   action_running_ = false;
   if (phase_ == "virtual") {
-    validated_.push_back(candidates(step_)[candidate_]);
-    plan_.steps[step_].trajectory = validated_.back();
+    plan_.steps[step_].trajectory = candidates(step_)[candidate_];
     status("VIRTUAL_ASSEMBLY", "virtual assembly: " + std::to_string(step_ + 1) + " of " +
                                    std::to_string(plan_.steps.size()) + " parts",
            double(step_ + 1) / plan_.steps.size());

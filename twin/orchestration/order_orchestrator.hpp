@@ -55,7 +55,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   OrderOrchestrator(std::string name, const LoadedProduct& product, const Plan& plan, OrderSettings settings);
 
   // The plan as virtual assembly left it: the sequence (replanned if cell-sim made it go
-  // back), each step with the trajectory cell-sim validated.
+  // back), each step done so far with the trajectory cell-sim validated.
   const Plan& plan() const { return plan_; }
   const std::string& error() const { return error_; }
 
@@ -112,7 +112,6 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::size_t command_count_ = 0;
   std::size_t step_ = 0, candidate_ = 0;
   std::string phase_;  // "virtual", "physical", "cleanup"
-  std::vector<Trajectory> validated_;
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
   std::set<std::string> delivered_, spawned_;
   std::map<std::string, PartIndex> fetch_of_;
