@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <thread>
 
 #include "deploy/cellctl/cell_config.hpp"
@@ -89,48 +90,114 @@ class RunningCell {
   std::vector<std::unique_ptr<Process>> processes_;
 };
 
+const char* state_name(cell::OrderState state) {
+  static const char* names[] = {"SUBMITTED", "PLANNING", "VIRTUAL_ASSEMBLY", "WAITING", "PHYSICAL_ASSEMBLY", "DONE",
+                                "FAILED"};
+  return names[state];
+}
+
 void print_progress(const cell::OrderStatus& s) {
-  static const char* names[] = {"SUBMITTED", "PLANNING", "VIRTUAL_ASSEMBLY", "PHYSICAL_ASSEMBLY", "DONE", "FAILED"};
-  std::cout << "[" << s.order_id() << "] t=" << static_cast<long>(s.sim_time() * 10) / 10.0 << " s  "
-            << names[s.state()] << "  " << static_cast<int>(s.progress() * 100) << "%  " << s.message() << std::endl;
+  std::cout << "[" << s.order_id() << "] t=" << fixed(s.sim_time(), 1) << " s  " << state_name(s.state()) << "  "
+            << static_cast<int>(s.progress() * 100) << "%  " << s.message() << std::endl;
 }
 
 struct SubmitOptions {
-  std::string product, order, out, sequence = "search", path = "linear";
+  std::vector<std::string> products;
+  std::string order, out, sequence = "search", path = "linear";
 };
 
-void add_submit_options(CLI::App* cmd, SubmitOptions& o) {
-  cmd->add_option("PRODUCT", o.product, "AutomationML file (.aml)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--order", o.order, "Order id (default: the product's name and a number)");
-  cmd->add_option("--out", o.out, "Folder for the plan and animation (default: out/ORDER)");
+void add_submit_options(CLI::App* cmd, SubmitOptions& o, bool several) {
+  auto* products = cmd->add_option("PRODUCT", o.products, several ? "AutomationML files (.aml): one order each" : "AutomationML file (.aml)")
+                       ->required()
+                       ->check(CLI::ExistingFile);
+  if (!several) products->expected(1);
+  cmd->add_option("--order", o.order, "Order id (one product only; default: the product's name)");
+  cmd->add_option("--out", o.out, "The order's folder (one product), or the folder of one folder per order "
+                                  "(default: out/ORDER)");
   cmd->add_option("--sequence", o.sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
   cmd->add_option("--path", o.path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
 }
 
-// Spawns the order's twin and follows it to its end; the twin's exit code.
-int submit(const CellConfig& cell, SubmitOptions o, CellObserver& observer, double wait_s) {
-  if (o.order.empty()) o.order = fs::path(o.product).stem().string() + "-" + std::to_string(::getpid());
-  if (o.out.empty()) o.out = (fs::path("out") / o.order).string();
-  observer.on_status([order = o.order](const cell::OrderStatus& s) {
-    if (s.order_id() == order) print_progress(s);
+struct Order {
+  std::string id, product, out;
+  std::unique_ptr<Process> twin;
+  int exit_code = -1;
+  double sim_start = 0, sim_end = 0;
+  long peak_rss_kb = 0;
+};
+
+// One order per product: ids from the product files' stems, numbered where one repeats.
+std::vector<Order> orders_of(const SubmitOptions& o) {
+  if (!o.order.empty() && o.products.size() > 1) throw CLI::ValidationError("--order", "names one order; give one product");
+  std::vector<Order> out;
+  std::map<std::string, int> seen;
+  for (const auto& product : o.products) {
+    const std::string stem = fs::path(product).stem().string();
+    const int n = ++seen[stem];
+    std::string id = o.order.empty() ? (n == 1 ? stem : stem + "-" + std::to_string(n)) : o.order;
+    std::string folder = o.products.size() == 1 && !o.out.empty() ? o.out
+                                                                   : (fs::path(o.out.empty() ? "out" : o.out) / id).string();
+    out.push_back({id, product, folder, nullptr});
+  }
+  return out;
+}
+
+// Spawns a twin per order at once and follows them to their ends, printing their progress.
+void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Order>& orders, CellObserver& observer,
+                double wait_s) {
+  std::set<std::string> ids;
+  for (const auto& order : orders) ids.insert(order.id);
+  observer.on_status([ids](const cell::OrderStatus& s) {
+    if (ids.count(s.order_id())) print_progress(s);
   });
-  std::vector<std::string> argv{executable_dir() + "/twin", "--domain", std::to_string(cell.domain), "--order", o.order,
-                                "--product", o.product, "--out", o.out, "--sequence", o.sequence, "--path", o.path,
-                                "--wait", std::to_string(wait_s), "--lease", std::to_string(cell.liveliness_lease),
-                                "--quiet"};
-  if (!cell.localhost_only) argv.push_back("--all-interfaces");
-  Process twin("twin-" + o.order, argv);
-  while (twin.poll() < 0) {
-    if (stop_requested) twin.stop();
-    std::this_thread::sleep_for(20ms);
+  for (auto& order : orders) {
+    std::vector<std::string> argv{executable_dir() + "/twin", "--domain", std::to_string(cell.domain), "--order", order.id,
+                                  "--product", order.product, "--out", order.out, "--sequence", o.sequence, "--path",
+                                  o.path, "--wait", std::to_string(wait_s), "--lease", std::to_string(cell.liveliness_lease),
+                                  "--quiet"};
+    if (!cell.localhost_only) argv.push_back("--all-interfaces");
+    order.sim_start = observer.sim_now();
+    order.twin = std::make_unique<Process>("twin-" + order.id, argv);
+  }
+  for (std::size_t running = orders.size(); running > 0;) {
+    running = 0;
+    for (auto& order : orders) {
+      if (order.exit_code >= 0) continue;
+      if (stop_requested) order.twin->stop();
+      order.peak_rss_kb = std::max(order.peak_rss_kb, order.twin->peak_rss_kb());
+      order.exit_code = order.twin->poll();
+      running += order.exit_code < 0;
+    }
+    std::this_thread::sleep_for(50ms);
   }
   observer.on_status({});
-  const int code = twin.poll();
-  // The twin is the only child reaped so far: the children's peak is its own.
-  struct rusage usage {};
-  if (::getrusage(RUSAGE_CHILDREN, &usage) == 0) std::cout << "twin peak RSS " << usage.ru_maxrss / 1024 << " MB\n";
-  if (code == 0) std::cout << "order " << o.order << " done: " << o.out << "/plan.json, " << o.out << "/animation.gltf\n";
-  return code;
+  const auto statuses = observer.orders();
+  for (auto& order : orders) {
+    const auto it = statuses.find(order.id);
+    order.sim_end = it != statuses.end() ? it->second.sim_time() : observer.sim_now();
+  }
+}
+
+// The orders' table and the makespan; true when every order was assembled.
+bool report_orders(const std::vector<Order>& orders, CellObserver& observer) {
+  const auto statuses = observer.orders();
+  TextTable table({"order", "product", "result", "sim start s", "sim end s", "twin peak RSS MB"});
+  double first = 1e300, last = 0;
+  bool all = true;
+  for (const auto& order : orders) {
+    const auto it = statuses.find(order.id);
+    std::string result = order.exit_code == 0 ? "assembled" : "failed (exit " + std::to_string(order.exit_code) + ")";
+    if (order.exit_code != 0 && it != statuses.end() && !it->second.message().empty()) result += ": " + it->second.message();
+    table.add_row({order.id, fs::path(order.product).filename().string(), result, fixed(order.sim_start, 1),
+                   fixed(order.sim_end, 1), std::to_string(order.peak_rss_kb / 1024)});
+    first = std::min(first, order.sim_start);
+    last = std::max(last, order.sim_end);
+    all &= order.exit_code == 0;
+  }
+  std::cout << '\n';
+  table.print(std::cout);
+  std::cout << "\nmakespan " << fixed(last - first, 1) << " sim s for " << orders.size() << " orders\n";
+  return all;
 }
 
 }  // namespace
@@ -167,12 +234,17 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
 
   CLI::App* submit_cmd = app.add_subcommand("submit", "Spawn a twin for an order and follow it to its end");
   add_cell_options(submit_cmd, *cell_options);
-  add_submit_options(submit_cmd, *submit_options);
+  add_submit_options(submit_cmd, *submit_options, false);
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
     const CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
     CellObserver observer(cell.domain, cell.localhost_only);
-    exit_code = submit(cell, *submit_options, observer, cell_options->wait_s);
+    auto orders = orders_of(*submit_options);
+    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
+    const Order& order = orders.front();
+    std::cout << "twin peak RSS " << order.peak_rss_kb / 1024 << " MB\n";
+    if (order.exit_code == 0) std::cout << "order " << order.id << " done: " << order.out << "/plan.json, " << order.out << "/animation.gltf\n";
+    exit_code = order.exit_code;
   });
 
   CLI::App* status = app.add_subcommand("status", "List the cell's resources and orders");
@@ -182,12 +254,13 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     CellObserver observer(cell.domain, cell.localhost_only);
     observer.wait_for_resources(cell.resource_ids(), 2s);
     std::this_thread::sleep_for(300ms);  // orders and resources outside the file
-    TextTable resources({"resource", "kind", "state", "work", "reserved by", "stock"});
+    TextTable resources({"resource", "kind", "state", "work", "queued", "reserved by", "waiting", "stock"});
     for (const auto& [id, r] : observer.resources()) {
-      std::string stock;
+      std::string stock, waiting;
       for (const auto& s : r.capability.stock()) stock += s.part_type() + "=" + std::to_string(s.count()) + " ";
+      for (const auto& w : r.capability.waiting()) waiting += (waiting.empty() ? "" : " ") + w;
       resources.add_row({id, r.capability.kind(), r.alive ? "alive" : "gone", r.capability.busy() ? "busy" : "idle",
-                         r.capability.reserved_by(), stock});
+                         std::to_string(r.capability.queued_commands()), r.capability.reserved_by(), waiting, stock});
     }
     std::cout << "Cell on domain " << cell.domain << ": " << observer.resources().size() << " resources\n\n";
     resources.print(std::cout);
@@ -218,9 +291,9 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::cout << "cell on domain " << cell.domain << " stopped\n";
   });
 
-  CLI::App* run = app.add_subcommand("run", "Start the cell, assemble one order, stop the cell");
+  CLI::App* run = app.add_subcommand("run", "Start the cell, assemble one order per product at once, stop the cell");
   add_cell_options(run, *cell_options);
-  add_submit_options(run, *submit_options);
+  add_submit_options(run, *submit_options, true);
   run->add_option("--events", *events, "Write every command event and delivery as JSON lines to this file");
   run->callback([cell_options, submit_options, events, &exit_code] {
     const CellConfig cell = cell_options->load();
@@ -231,7 +304,11 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     const auto started = std::chrono::steady_clock::now();
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
     std::cout << "cell up on domain " << cell.domain << ", real-time factor " << cell.real_time_factor << std::endl;
-    exit_code = submit(cell, *submit_options, observer, cell_options->wait_s);
+    auto orders = orders_of(*submit_options);
+    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
+    const bool all = report_orders(orders, observer);
+    exit_code = all ? 0 : 1;
+    if (orders.size() == 1 && orders.front().exit_code == 2) exit_code = 2;  // a bad product description
     const auto rss = running.peak_rss();
     running.stop();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

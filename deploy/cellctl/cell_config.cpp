@@ -1,5 +1,6 @@
 #include "deploy/cellctl/cell_config.hpp"
 
+#include <cmath>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
@@ -47,10 +48,75 @@ void add_point(std::vector<std::string>& argv, const char* option, const Point& 
 }  // namespace
 
 std::vector<std::string> CellConfig::resource_ids() const {
-  std::vector<std::string> ids{station, arm, robot};
+  std::vector<std::string> ids;
+  for (const auto& s : stations) ids.insert(ids.end(), {s.id, s.arm});
+  for (const auto& r : robots) ids.push_back(r.id);
   for (const auto& b : buffers) ids.push_back(b.id);
   return ids;
 }
+
+namespace {
+
+StationConfig read_station(const std::filesystem::path& file, const YAML::Node& s) {
+  if (!s.IsMap()) throw ConfigError(where(file, s) + ": a station is a map of keys");
+  known_keys(file, s, {"id", "arm", "position", "dock", "table", "arm_speed", "arm_angular_speed"});
+  StationConfig c;
+  read(file, s, "id", c.id);
+  read(file, s, "arm", c.arm);
+  read_point(file, s, "position", c.position);
+  read_point(file, s, "dock", c.dock);
+  read_point(file, s, "table", c.table);
+  read(file, s, "arm_speed", c.arm_speed);
+  read(file, s, "arm_angular_speed", c.arm_angular_speed);
+  if (c.arm_speed <= 0 || c.arm_angular_speed <= 0) throw ConfigError(where(file, s) + ": arm speeds must be above 0");
+  for (double h : c.table) {
+    if (h <= 0) throw ConfigError(where(file, s["table"]) + ": a table's half extents must be above 0");
+  }
+  return c;
+}
+
+RobotConfig read_robot(const std::filesystem::path& file, const YAML::Node& r) {
+  if (!r.IsMap()) throw ConfigError(where(file, r) + ": a mobile robot is a map of keys");
+  known_keys(file, r, {"id", "home", "speed"});
+  RobotConfig c;
+  read(file, r, "id", c.id);
+  read_point(file, r, "home", c.home);
+  read(file, r, "speed", c.speed);
+  if (c.speed <= 0) throw ConfigError(where(file, r) + ": speed must be above 0");
+  return c;
+}
+
+// `single: {...}` is shorthand for `list: [{...}]`; a file has one or the other.
+template <class T, class ReadOne>
+void read_list(const std::filesystem::path& file, const YAML::Node& root, const char* single, const char* list,
+               std::vector<T>& out, std::vector<YAML::Node>& nodes, ReadOne read_one) {
+  if (root[single] && root[list]) {
+    throw ConfigError(where(file, root[list]) + ": '" + single + "' and '" + list + "' together; use '" + list + "'");
+  }
+  if (const auto one = root[single]) {
+    out = {read_one(file, one)};
+    nodes = {one};
+  } else if (const auto many = root[list]) {
+    if (!many.IsSequence() || many.size() == 0) throw ConfigError(where(file, many) + ": '" + list + "' needs a list of one or more");
+    out.clear();
+    nodes.clear();
+    for (const auto& item : many) {
+      out.push_back(read_one(file, item));
+      nodes.push_back(item);
+    }
+  }
+}
+
+// Tables are boxes under their station's point; touching is allowed, overlapping is not.
+bool overlap(const StationConfig& a, const StationConfig& b) {
+  for (int i = 0; i < 3; ++i) {
+    const double ca = a.position[i] - (i == 1 ? a.table[1] : 0), cb = b.position[i] - (i == 1 ? b.table[1] : 0);
+    if (std::abs(ca - cb) >= a.table[i] + b.table[i] - 1e-9) return false;
+  }
+  return true;
+}
+
+}  // namespace
 
 CellConfig read_cell_config(const std::filesystem::path& file) {
   YAML::Node root;
@@ -65,29 +131,19 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   CellConfig c;
   c.file = file;
   known_keys(file, root,
-             {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "mobile_robot", "buffers"});
+             {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
+              "mobile_robots", "buffers"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
   read(file, root, "localhost_only", c.localhost_only);
   if (c.domain < 0 || c.domain > 232) throw ConfigError(where(file, root["domain"]) + ": domain must be 0..232");
   if (c.real_time_factor <= 0) throw ConfigError(where(file, root["real_time_factor"]) + ": must be above 0");
-  if (const auto s = root["station"]) {
-    known_keys(file, s, {"id", "arm", "position", "dock", "table", "arm_speed", "arm_angular_speed"});
-    read(file, s, "id", c.station);
-    read(file, s, "arm", c.arm);
-    read_point(file, s, "position", c.station_position);
-    read_point(file, s, "dock", c.dock);
-    read_point(file, s, "table", c.table);
-    read(file, s, "arm_speed", c.arm_speed);
-    read(file, s, "arm_angular_speed", c.arm_angular_speed);
-  }
-  if (const auto r = root["mobile_robot"]) {
-    known_keys(file, r, {"id", "home", "speed"});
-    read(file, r, "id", c.robot);
-    read_point(file, r, "home", c.robot_home);
-    read(file, r, "speed", c.robot_speed);
-  }
+  if (c.liveliness_lease <= 0) throw ConfigError(where(file, root["liveliness_lease"]) + ": must be above 0");
+  std::vector<YAML::Node> station_nodes, robot_nodes;
+  read_list(file, root, "station", "stations", c.stations, station_nodes, read_station);
+  read_list(file, root, "mobile_robot", "mobile_robots", c.robots, robot_nodes, read_robot);
+  std::vector<YAML::Node> buffer_nodes;
   for (const auto& b : root["buffers"]) {
     known_keys(file, b, {"id", "position", "stock"});
     BufferConfig buffer;
@@ -96,10 +152,26 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read_point(file, b, "position", buffer.position);
     read(file, b, "stock", buffer.stock);
     c.buffers.push_back(buffer);
+    buffer_nodes.push_back(b);
   }
+  std::vector<std::pair<std::string, YAML::Node>> named;  // every resource id, where it stands
+  for (std::size_t i = 0; i < c.stations.size(); ++i) {
+    const YAML::Node node = i < station_nodes.size() ? station_nodes[i] : root;
+    named.insert(named.end(), {{c.stations[i].id, node}, {c.stations[i].arm, node}});
+  }
+  for (std::size_t i = 0; i < c.robots.size(); ++i) named.push_back({c.robots[i].id, i < robot_nodes.size() ? robot_nodes[i] : root});
+  for (std::size_t i = 0; i < c.buffers.size(); ++i) named.push_back({c.buffers[i].id, buffer_nodes[i]});
   std::set<std::string> ids;
-  for (const auto& id : c.resource_ids()) {
-    if (!ids.insert(id).second) throw ConfigError(file.string() + ": two resources are called '" + id + "'");
+  for (const auto& [id, node] : named) {
+    if (!ids.insert(id).second) throw ConfigError(where(file, node) + ": a second resource is called '" + id + "'");
+  }
+  for (std::size_t i = 0; i < c.stations.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (overlap(c.stations[i], c.stations[j])) {
+        throw ConfigError(where(file, station_nodes[i]) + ": the table of " + c.stations[i].id + " overlaps the table of " +
+                          c.stations[j].id);
+      }
+    }
   }
   return c;
 }
@@ -109,17 +181,21 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
   std::vector<ProcessSpec> out;
   out.push_back({"cell-sim", {(bin / "cell-sim").string(), "--domain", domain, "--real-time-factor",
                               std::to_string(c.real_time_factor)}});
-  ProcessSpec station{c.station, {(bin / "station").string(), "--domain", domain, "--id", c.station, "--arm-id", c.arm,
-                                  "--arm-speed", std::to_string(c.arm_speed), "--arm-angular-speed",
-                                  std::to_string(c.arm_angular_speed), "--lease", lease}};
-  add_point(station.argv, "--position", c.station_position);
-  add_point(station.argv, "--dock", c.dock);
-  add_point(station.argv, "--table", c.table);
-  out.push_back(station);
-  ProcessSpec robot{c.robot, {(bin / "mobile-robot").string(), "--domain", domain, "--id", c.robot, "--speed",
-                              std::to_string(c.robot_speed), "--lease", lease}};
-  add_point(robot.argv, "--home", c.robot_home);
-  out.push_back(robot);
+  for (const auto& st : c.stations) {
+    ProcessSpec station{st.id, {(bin / "station").string(), "--domain", domain, "--id", st.id, "--arm-id", st.arm,
+                                "--arm-speed", std::to_string(st.arm_speed), "--arm-angular-speed",
+                                std::to_string(st.arm_angular_speed), "--lease", lease}};
+    add_point(station.argv, "--position", st.position);
+    add_point(station.argv, "--dock", st.dock);
+    add_point(station.argv, "--table", st.table);
+    out.push_back(station);
+  }
+  for (const auto& r : c.robots) {
+    ProcessSpec robot{r.id, {(bin / "mobile-robot").string(), "--domain", domain, "--id", r.id, "--speed",
+                             std::to_string(r.speed), "--lease", lease}};
+    add_point(robot.argv, "--home", r.home);
+    out.push_back(robot);
+  }
   for (const auto& b : c.buffers) {
     ProcessSpec buffer{b.id, {(bin / "buffer").string(), "--domain", domain, "--id", b.id, "--lease", lease}};
     add_point(buffer.argv, "--position", b.position);

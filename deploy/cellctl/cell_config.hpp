@@ -12,6 +12,18 @@ namespace cellctl {
 
 using Point = std::array<double, 3>;
 
+struct StationConfig {
+  std::string id = "station-1", arm = "arm-1";
+  Point position{}, dock{0.6, 0, 0}, table{1.0, 0.025, 1.0};  // table: half extents, its top at position
+  double arm_speed = 0.25, arm_angular_speed = 1.0;
+};
+
+struct RobotConfig {
+  std::string id = "mobile-robot-1";
+  Point home{1.5, 0, 1.2};
+  double speed = 0.8;
+};
+
 struct BufferConfig {
   std::string id;
   Point position{};
@@ -22,14 +34,10 @@ struct CellConfig {
   std::filesystem::path file;
   int domain = 42;
   double real_time_factor = 1;
-  double liveliness_lease = 1;
-  bool localhost_only = true;  // false: every process uses every network interface
-  std::string station = "station-1", arm = "arm-1";
-  Point station_position{}, dock{0.6, 0, 0}, table{1.0, 0.025, 1.0};
-  double arm_speed = 0.25, arm_angular_speed = 1.0;
-  std::string robot = "mobile-robot-1";
-  Point robot_home{1.5, 0, 1.2};
-  double robot_speed = 0.8;
+  double liveliness_lease = 5;  // s: a process starved of CPU for 2 s is not taken for gone
+  bool localhost_only = true;   // false: every process uses every network interface
+  std::vector<StationConfig> stations{StationConfig{}};
+  std::vector<RobotConfig> robots{RobotConfig{}};
   std::vector<BufferConfig> buffers;
 
   std::vector<std::string> resource_ids() const;

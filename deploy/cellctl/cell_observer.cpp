@@ -7,6 +7,7 @@
 #include "ordersPubSubTypes.h"
 #include "services/dds/conversions.hpp"
 #include "services/dds/endpoints.hpp"
+#include "services/dds/sim_clock.hpp"
 
 namespace cellctl {
 namespace {
@@ -16,6 +17,7 @@ namespace {
 
 struct CellObserver::Impl {
   dds::ParticipantPtr participant;
+  std::unique_ptr<dds::SimClock> clock;
   std::unique_ptr<dds::Reader<cell::Capability, cell::CapabilityPubSubType>> capabilities;
   std::unique_ptr<dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType>> statuses;
   std::unique_ptr<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>> events;
@@ -23,6 +25,7 @@ struct CellObserver::Impl {
 
 CellObserver::CellObserver(int domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
   impl_->participant = dds::make_participant("cellctl", {domain, localhost_only});
+  impl_->clock = std::make_unique<dds::SimClock>(impl_->participant);
   const auto changed = [this](auto&& f) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -104,6 +107,8 @@ std::map<std::string, cell::OrderStatus> CellObserver::orders() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return orders_;
 }
+
+double CellObserver::sim_now() const { return impl_->clock->now(); }
 
 std::size_t CellObserver::events_logged() const {
   std::lock_guard<std::mutex> lock(mutex_);

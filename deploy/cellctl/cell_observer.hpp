@@ -38,6 +38,7 @@ class CellObserver {
   std::map<std::string, ResourceView> resources() const;
   std::map<std::string, cell::OrderStatus> orders() const;
   std::size_t events_logged() const;
+  double sim_now() const;  // the cell's sim time, s (0 before cell-sim's clock is heard)
 
  private:
   struct Impl;

@@ -20,6 +20,7 @@ CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : Basic
   declare_output("STOP", {"command_id"});
   declare_output("CANCELED", {"command_id"});
   declare_output("REJECTED", {"command_id", "reason"});
+  declare_output("IDLE");
 
   const auto is_current = [this](const Data& d) { return get<std::string>(d, "command_id") == command_; };
   const auto queue_is_empty = [this](const Data&) { return queue_.empty(); };
@@ -32,12 +33,18 @@ CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : Basic
   transition("EXECUTING", "PROGRESS", "EXECUTING", [this](const Data& d) { emit("EXECUTING", with_id(d)); });
   // An outcome ends the command; the next queued one starts at once.
   for (const char* state : {"EXECUTING", "CANCELING"}) {
-    transition(state, "DONE", "IDLE", [this](const Data& d) { emit("SUCCEEDED", with_id(d)); }, queue_is_empty);
+    transition(state, "DONE", "IDLE", [this](const Data& d) {
+      emit("SUCCEEDED", with_id(d));
+      emit("IDLE");
+    }, queue_is_empty);
     transition(state, "DONE", "EXECUTING", [this](const Data& d) {
       emit("SUCCEEDED", with_id(d));
       start_next();
     });
-    transition(state, "FAIL", "IDLE", [this](const Data& d) { emit("ABORTED", with_id(d)); }, queue_is_empty);
+    transition(state, "FAIL", "IDLE", [this](const Data& d) {
+      emit("ABORTED", with_id(d));
+      emit("IDLE");
+    }, queue_is_empty);
     transition(state, "FAIL", "EXECUTING", [this](const Data& d) {
       emit("ABORTED", with_id(d));
       start_next();
@@ -58,7 +65,10 @@ CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : Basic
       emit("CANCELED", {{"command_id", id}});
     }, is_queued);
   }
-  transition("CANCELING", "STOPPED", "IDLE", [this](const Data&) { emit("CANCELED", with_id({})); }, queue_is_empty);
+  transition("CANCELING", "STOPPED", "IDLE", [this](const Data&) {
+    emit("CANCELED", with_id({}));
+    emit("IDLE");
+  }, queue_is_empty);
   transition("CANCELING", "STOPPED", "EXECUTING", [this](const Data&) {
     emit("CANCELED", with_id({}));
     start_next();

@@ -15,6 +15,7 @@
 //   STOPPED                        CANCELING, STOP       (command_id)
 //                                  CANCELED              (command_id)
 //                                  REJECTED              (command_id, reason)
+//                                  IDLE: nothing executes and nothing waits any more
 // CANCEL of a queued command takes it out at once (CANCELED); of the executing one, asks the
 // device to STOP (a device that finishes first: its outcome stands).
 // Data the device adds to PROGRESS, DONE and FAIL (a sim time, a distance) goes out with

@@ -1,54 +1,125 @@
 #include "services/blocks/contractor.hpp"
 
+#include <algorithm>
+
 namespace fb {
 
-Contractor::Contractor(std::string name, std::string resource_id, bool exclusive, CanServe can_serve, double duration)
-    : BasicBlock(std::move(name), "FREE"), resource_id_(std::move(resource_id)), can_serve_(std::move(can_serve)),
-      duration_(duration) {
-  declare_input("CFP", {"call_id", "order_id", "operation", "part_type"});
+Contractor::Contractor(std::string name, std::string resource_id, std::set<std::string> offers, bool exclusive,
+                       EstimateFn estimate, Clock now)
+    : BasicBlock(std::move(name), "READY"), resource_id_(std::move(resource_id)), offers_(std::move(offers)),
+      exclusive_(exclusive),
+      estimate_(std::move(estimate)), now_(std::move(now)) {
+  declare_input("CFP", {"call_id", "order_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_input("AWARD", {"call_id", "resource_id", "order_id"});
   declare_input("RELEASE", {"order_id", "resource_id"});
   declare_input("ORDER_ENDED", {"order_id"});
-  declare_output("PROPOSE", {"call_id", "earliest_start", "duration"});
-  declare_output("REPLY", {"call_id", "confirmed", "reason"});
+  declare_input("IDLE");
+  declare_output("PROPOSE", {"call_id", "available", "reason", "earliest_start", "duration"});
+  declare_output("REPLY", {"call_id", "confirmed", "reason", "ahead"});
   declare_output("RESERVED", {"order_id"});
+  declare_output("AWARDED", {"call_id", "order_id", "duration"});
 
-  const auto servable = [this](const Data& d) {
-    return can_serve_(get<std::string>(d, "operation"), get<std::string>(d, "part_type"));
-  };
   const auto for_me = [this](const Data& d) { return get<std::string>(d, "resource_id") == resource_id_; };
-  const auto of_holder = [this](const Data& d) { return get<std::string>(d, "order_id") == order_; };
-  const auto propose = [this](const Data& d) {
-    emit("PROPOSE", {{"call_id", get<std::string>(d, "call_id")}, {"earliest_start", 0.0}, {"duration", duration_}});
-  };
-  const auto reply = [this](const Data& d, bool confirmed, const std::string& reason) {
-    emit("REPLY", {{"call_id", get<std::string>(d, "call_id")}, {"confirmed", confirmed}, {"reason", reason}});
-  };
+  transition("READY", "CFP", "READY", [this](const Data& d) { propose(d); },
+             [this](const Data& d) { return offers_.count(get<std::string>(d, "operation")) > 0; });
+  transition("READY", "AWARD", "READY", [this](const Data& d) { award(d); }, for_me);
+  transition("READY", "RELEASE", "READY", [this](const Data& d) { end(get<std::string>(d, "order_id")); }, for_me);
+  transition("READY", "ORDER_ENDED", "READY", [this](const Data& d) { end(get<std::string>(d, "order_id")); });
+  transition("READY", "IDLE", "READY", [this](const Data&) { busy_until_ = now_(); });
+}
 
-  transition("FREE", "CFP", "FREE", propose, servable);
-  if (!exclusive) {
-    transition("FREE", "AWARD", "FREE", [reply](const Data& d) { reply(d, true, ""); }, for_me);
+std::vector<std::string> Contractor::waiting() const {
+  std::vector<std::string> out;
+  for (const Hold& h : waiting_) out.push_back(h.order);
+  return out;
+}
+
+bool Contractor::serves(const std::string& order) const {
+  return exclusive_ ? !order.empty() && holder_.order == order : work_.count(order) > 0;
+}
+
+// Exclusive: after the holder's expected end and the expected holds of those waiting.
+// Shared: after the work taken on.
+double Contractor::earliest_start(const std::string& order) const {
+  const double now = now_();
+  if (!exclusive_) return std::max(now, busy_until_);
+  if (holder_.order.empty() || holder_.order == order) return now;
+  double start = std::max(now, holder_.until);
+  for (const Hold& h : waiting_) {
+    if (h.order == order) break;
+    start += h.duration;
+  }
+  return start;
+}
+
+void Contractor::propose(const Data& call) {
+  const Estimate e = estimate_(call);
+  const std::string& id = get<std::string>(call, "call_id");
+  if (e.available) {
+    Data offered = call;
+    offered["duration"] = e.duration;
+    bids_[id] = std::move(offered);
+  }
+  emit("PROPOSE", {{"call_id", id}, {"available", e.available}, {"reason", e.reason},
+                   {"earliest_start", e.available ? earliest_start(get<std::string>(call, "order_id")) : 0.0},
+                   {"duration", e.duration}});
+}
+
+void Contractor::reply(const std::string& call_id, bool confirmed, const std::string& reason, long ahead) {
+  emit("REPLY", {{"call_id", call_id}, {"confirmed", confirmed}, {"reason", reason}, {"ahead", std::int64_t(ahead)}});
+}
+
+void Contractor::award(const Data& d) {
+  const std::string& call = get<std::string>(d, "call_id");
+  const std::string& order = get<std::string>(d, "order_id");
+  const auto bid = bids_.find(call);
+  if (bid == bids_.end()) return reply(call, false, resource_id_ + " made no offer for call " + call, 0);
+  Data awarded = std::move(bid->second);
+  bids_.erase(bid);
+  awarded["order_id"] = order;
+  const double duration = get<double>(awarded, "duration");
+  const double now = now_();
+  if (!exclusive_) {
+    ++work_[order];
+    busy_until_ = std::max(now, busy_until_) + duration;
+    reply(call, true, "", 0);
+    return emit("AWARDED", std::move(awarded));
+  }
+  if (holder_.order.empty() || holder_.order == order) {
+    holder_ = {order, now + duration, duration};
+    reply(call, true, "", 0);
+  } else {
+    auto it = std::find_if(waiting_.begin(), waiting_.end(), [&](const Hold& h) { return h.order == order; });
+    if (it == waiting_.end()) it = waiting_.insert(waiting_.end(), {order, 0, duration});
+    reply(call, true, "", 1 + (it - waiting_.begin()));
+  }
+  emit("RESERVED", {{"order_id", holder_.order}});
+  emit("AWARDED", std::move(awarded));
+}
+
+// The order is done with this resource: released, or ended.
+void Contractor::end(const std::string& order) {
+  for (auto it = bids_.begin(); it != bids_.end();) {
+    it = get<std::string>(it->second, "order_id") == order ? bids_.erase(it) : std::next(it);
+  }
+  if (!exclusive_) {
+    work_.erase(order);
     return;
   }
-  transition("FREE", "AWARD", "RESERVED", [this, reply](const Data& d) {
-    order_ = get<std::string>(d, "order_id");
-    reply(d, true, "");
-    emit("RESERVED", {{"order_id", order_}});
-  }, for_me);
-  // Reserved: the holder may call again (another operation of its order); others wait.
-  transition("RESERVED", "CFP", "RESERVED", propose,
-             [servable, of_holder](const Data& d) { return servable(d) && of_holder(d); });
-  transition("RESERVED", "AWARD", "RESERVED", [reply](const Data& d) { reply(d, true, ""); },
-             [for_me, of_holder](const Data& d) { return for_me(d) && of_holder(d); });
-  transition("RESERVED", "AWARD", "RESERVED", [this, reply](const Data& d) {
-    reply(d, false, resource_id_ + " is reserved by order " + order_);
-  }, for_me);
-  const auto free = [this](const Data&) {
-    order_.clear();
-    emit("RESERVED", {{"order_id", std::string()}});
-  };
-  transition("RESERVED", "RELEASE", "FREE", free, [for_me, of_holder](const Data& d) { return for_me(d) && of_holder(d); });
-  transition("RESERVED", "ORDER_ENDED", "FREE", free, of_holder);
+  const auto it = std::find_if(waiting_.begin(), waiting_.end(), [&](const Hold& h) { return h.order == order; });
+  if (it != waiting_.end()) {
+    waiting_.erase(it);
+  } else if (holder_.order == order && !order.empty()) {
+    holder_ = {};
+    if (!waiting_.empty()) {
+      holder_ = waiting_.front();
+      holder_.until = now_() + holder_.duration;
+      waiting_.pop_front();
+    }
+  } else {
+    return;
+  }
+  emit("RESERVED", {{"order_id", holder_.order}});
 }
 
 }  // namespace fb

@@ -1,19 +1,31 @@
 #pragma once
-// The resource's side of the contract net (design.md 7): it answers calls for proposals it
-// can serve, and confirms or refuses awards. An exclusive resource (station, arm, mobile
-// robot) is reserved by the order it confirmed until that order releases it or ends (its
-// twin finished, failed or disappeared); a shared one (a buffer) confirms every award.
-// It knows nothing about products: what it can serve is a predicate on operation and part
-// type, given by the service.
+// The resource's side of the contract net (design.md 7), after Open-RMF's bidding: every call
+// for an operation the resource offers gets an answer, a bid or a refusal with the reason. A bid
+// says when the resource could start (from its own queue) and how long the work would take
+// (from the device: its distances and speeds, or the caller's estimate of how long it holds
+// an exclusive resource). It knows nothing about products: what it can do, and how long it
+// takes, come from the service through `estimate`.
+//
+//  - An exclusive resource (a station, an arm) is held by one order at a time. An award
+//    while it is held is confirmed as a place in its queue of waiting orders ("ahead": the
+//    orders before it); when the holder releases it or ends (finished, failed, its twin
+//    gone), the next in the queue holds it, and RESERVED says so.
+//  - A shared resource (a mobile robot, a buffer) confirms every award and takes the work
+//    into its queue: its next bid starts after the work it has taken.
 //
 //   inputs                                         outputs
-//   CFP     (call_id, order_id, operation,         PROPOSE  (call_id, earliest_start, duration)
-//            part_type)                            REPLY    (call_id, confirmed, reason)
-//   AWARD   (call_id, resource_id, order_id)       RESERVED (order_id): "" when free again
-//   RELEASE (order_id, resource_id)
-//   ORDER_ENDED (order_id)
+//   CFP     (call_id, order_id, operation, ...)    PROPOSE  (call_id, available, reason, earliest_start, duration)
+//   AWARD   (call_id, resource_id, order_id)       REPLY    (call_id, confirmed, reason, ahead)
+//   RELEASE (order_id, resource_id)                RESERVED (order_id): the holder changed, or the queue
+//   ORDER_ENDED (order_id)                         AWARDED  (the call's data, duration): work taken on
+//   IDLE: the device has no work left (a shared resource's queue estimate starts again from now)
 
+#include <deque>
 #include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
 
 #include "services/runtime/basic_block.hpp"
 
@@ -21,17 +33,47 @@ namespace fb {
 
 class Contractor : public BasicBlock {
  public:
-  using CanServe = std::function<bool(const std::string& operation, const std::string& part_type)>;
-  // `duration`: what the resource proposes for one operation, s of sim time.
-  Contractor(std::string name, std::string resource_id, bool exclusive, CanServe can_serve, double duration = 0);
+  struct Estimate {
+    bool available = false;
+    std::string reason;     // why not, when not available
+    double duration = 0;    // s of sim time
+  };
+  // The device's answer to a call (operation, part_type, station, sources, count, duration).
+  using EstimateFn = std::function<Estimate(const Data& call)>;
+  using Clock = std::function<double()>;  // sim time now
 
-  const std::string& reserved_by() const { return order_; }
+  // `offers`: the operations it bids for; calls for others go unanswered.
+  Contractor(std::string name, std::string resource_id, std::set<std::string> offers, bool exclusive,
+             EstimateFn estimate, Clock now);
+  const std::set<std::string>& offers() const { return offers_; }
+
+  const std::string& reserved_by() const { return holder_.order; }
+  std::vector<std::string> waiting() const;
+  // Whether the order holds this resource (exclusive) or has work taken on by it (shared).
+  bool serves(const std::string& order) const;
 
  private:
+  struct Hold {
+    std::string order;
+    double until = 0;  // expected end, sim s
+    double duration = 0;
+  };
+  double earliest_start(const std::string& order) const;
+  void award(const Data& award);
+  void end(const std::string& order);
+  void propose(const Data& call);
+  void reply(const std::string& call_id, bool confirmed, const std::string& reason, long ahead);
+
   std::string resource_id_;
-  CanServe can_serve_;
-  double duration_;
-  std::string order_;
+  std::set<std::string> offers_;
+  bool exclusive_;
+  EstimateFn estimate_;
+  Clock now_;
+  Hold holder_;                                // exclusive: who holds it
+  std::deque<Hold> waiting_;                   // exclusive: who waits, in turn
+  std::map<std::string, Data> bids_;           // call id -> the call offered for, with the bid's duration
+  std::map<std::string, int> work_;            // shared: order -> awards taken on
+  double busy_until_ = 0;                      // shared: the end of the work taken on
 };
 
 }  // namespace fb

@@ -4,12 +4,22 @@ namespace fb {
 
 BufferBlock::BufferBlock(std::string name, std::string resource_id, std::map<std::string, int> stock)
     : DeviceBlock(std::move(name), std::move(resource_id), {"give"}), stock_(std::move(stock)) {
+  declare_input("AWARDED", {"order_id", "part_type", "count"});
   declare_output("CAPABILITY");
+  transition("READY", "AWARDED", "READY", [this](const Data& d) {
+    kept_[get<std::string>(d, "order_id")][get<std::string>(d, "part_type")] +=
+        static_cast<int>(get_or<std::int64_t>(d, "count", 1));
+  });
   transition("READY", "START", "READY", [this](const Data& d) {
     // A command names the type it wants; older senders put it in "part".
     std::string type = get_or<std::string>(d, "part_type", "");
     if (type.empty()) type = get<std::string>(d, "part");
-    if (count(type) == 0) return emit("FAIL", {{"reason", "buffer " + this->resource_id() + " has no " + type}});
+    const std::string order = get_or<std::string>(d, "order_id", "");
+    int& kept = kept_[order][type];
+    if (kept == 0 && free(type) == 0) {
+      return emit("FAIL", {{"reason", "buffer " + this->resource_id() + " has no " + type + " for order " + order}});
+    }
+    if (kept > 0) --kept;
     --stock_[type];
     emit("DONE");
     emit("CAPABILITY");
@@ -20,5 +30,16 @@ int BufferBlock::count(const std::string& part_type) const {
   const auto it = stock_.find(part_type);
   return it == stock_.end() ? 0 : it->second;
 }
+
+int BufferBlock::free(const std::string& part_type) const {
+  int n = count(part_type);
+  for (const auto& [order, types] : kept_) {
+    const auto it = types.find(part_type);
+    if (it != types.end()) n -= it->second;
+  }
+  return n;
+}
+
+void BufferBlock::order_ended(const std::string& order) { kept_.erase(order); }
 
 }  // namespace fb

@@ -1,8 +1,11 @@
 #pragma once
 // A part buffer: holds counts of part types and gives one part per "give" command. It knows
-// no products: a part type is a name.
+// no products: a part type is a name. An award keeps parts for the order that won it, so
+// that two orders never count on the same part; what an order does not take goes back to
+// the free stock when the order ends.
 //
-//   START (part_type)  ->  DONE, CAPABILITY (the stock changed)  or  FAIL (reason)
+//   AWARDED (order_id, part_type, count): keep that many for the order
+//   START (order_id, part_type)  ->  DONE, CAPABILITY (the stock changed)  or  FAIL (reason)
 
 #include <map>
 #include <string>
@@ -16,9 +19,14 @@ class BufferBlock : public DeviceBlock {
   BufferBlock(std::string name, std::string resource_id, std::map<std::string, int> stock);
   const std::map<std::string, int>& stock() const { return stock_; }
   int count(const std::string& part_type) const;
+  // Not kept for any order.
+  int free(const std::string& part_type) const;
 
  private:
+  void order_ended(const std::string& order) override;
+
   std::map<std::string, int> stock_;
+  std::map<std::string, std::map<std::string, int>> kept_;  // order -> type -> parts kept for it
 };
 
 }  // namespace fb

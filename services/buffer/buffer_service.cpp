@@ -7,10 +7,17 @@ namespace services {
 BufferService::BufferService(BufferConfig config) : resource_(config.node.id, 256) {
   config.node.kind = "buffer";
   config.node.exclusive = false;
+  config.node.offers = {"give"};
   config.node.dock = config.node.position;
   auto& buffer = resource_.add(std::make_unique<fb::BufferBlock>("buffer", config.node.id, config.stock));
-  const auto can_serve = [&buffer](const std::string& operation, const std::string& part_type) {
-    return operation == "give" && buffer.count(part_type) > 0;
+  const std::string id = config.node.id;
+  const auto estimate = [&buffer, id](const fb::Data& call) {
+    fb::Contractor::Estimate e;
+    const std::string& type = fb::get<std::string>(call, "part_type");
+    const auto wanted = fb::get_or<std::int64_t>(call, "count", 1);
+    e.available = buffer.free(type) >= wanted;
+    if (!e.available) e.reason = id + " has " + std::to_string(buffer.free(type)) + " " + type + " free, not " + std::to_string(wanted);
+    return e;
   };
   const auto describe = [&buffer](cell::Capability& c) {
     for (const auto& [type, count] : buffer.stock()) {
@@ -21,7 +28,7 @@ BufferService::BufferService(BufferConfig config) : resource_(config.node.id, 25
     }
   };
   node_ = std::make_unique<ResourceNode>(resource_, dds::make_participant(config.node.id, config.dds), config.node,
-                                         buffer, can_serve, describe);
+                                         buffer, estimate, describe);
   node_->start();
 }
 

@@ -97,6 +97,8 @@ cell::SimRequest to_sim_request(const fb::Data& d) {
   r.requester(text("requester"));
   r.kind(text("kind"));
   r.body_id(text("body_id"));
+  r.scene(text("scene"));
+  r.fixture(fb::get_or<bool>(d, "fixture", false));
   r.mesh_uri(text("mesh_uri"));
   r.half_extents(to_vec3(fb::get_or<fb::Numbers>(d, "half_extents", {0, 0, 0})));
   const auto placement = to_path(fb::get_or<fb::Numbers>(d, "placement", {0, 0, 0, 1, 0, 0, 0}));
@@ -119,6 +121,8 @@ fb::Data to_data(const cell::SimRequest& r) {
           {"requester", r.requester()},
           {"kind", r.kind()},
           {"body_id", r.body_id()},
+          {"scene", r.scene()},
+          {"fixture", r.fixture()},
           {"mesh_uri", r.mesh_uri()},
           {"half_extents", to_numbers(r.half_extents())},
           {"placement", to_numbers(std::vector<cell::Pose>{r.placement()})},
@@ -143,6 +147,99 @@ cell::SimReply to_sim_reply(const fb::Data& d) {
   r.end_time(fb::get_or<double>(d, "end_time", 0));
   r.distance(fb::get_or<double>(d, "distance", 0));
   return r;
+}
+
+}  // namespace dds
+
+namespace dds {
+namespace {
+std::string text(const fb::Data& d, const char* key) { return fb::get_or<std::string>(d, key, ""); }
+}  // namespace
+
+fb::Data to_data(const cell::CallForProposals& c) {
+  return {{"call_id", c.call_id()},     {"order_id", c.order_id()}, {"operation", c.operation()},
+          {"part_type", c.part_type()}, {"count", std::int64_t(c.count())}, {"station", c.station()},
+          {"sources", fb::join_names(c.sources())}, {"duration", c.duration()}};
+}
+
+cell::CallForProposals to_call(const fb::Data& d) {
+  cell::CallForProposals c;
+  c.call_id(text(d, "call_id"));
+  c.order_id(text(d, "order_id"));
+  c.operation(text(d, "operation"));
+  c.part_type(text(d, "part_type"));
+  c.count(static_cast<int32_t>(fb::get_or<std::int64_t>(d, "count", 0)));
+  c.station(text(d, "station"));
+  c.sources(fb::split_names(text(d, "sources")));
+  c.duration(fb::get_or<double>(d, "duration", 0));
+  return c;
+}
+
+fb::Data to_data(const cell::Proposal& p) {
+  return {{"call_id", p.call_id()},   {"resource_id", p.resource_id()}, {"available", p.available()},
+          {"reason", p.reason()},     {"earliest_start", p.earliest_start()}, {"duration", p.duration()}};
+}
+
+cell::Proposal to_proposal(const fb::Data& d) {
+  cell::Proposal p;
+  p.call_id(text(d, "call_id"));
+  p.resource_id(text(d, "resource_id"));
+  p.available(fb::get_or<bool>(d, "available", false));
+  p.reason(text(d, "reason"));
+  p.earliest_start(fb::get_or<double>(d, "earliest_start", 0));
+  p.duration(fb::get_or<double>(d, "duration", 0));
+  return p;
+}
+
+fb::Data to_data(const cell::Award& a) {
+  return {{"call_id", a.call_id()}, {"resource_id", a.resource_id()}, {"order_id", a.order_id()}, {"lease", a.lease()}};
+}
+
+cell::Award to_award(const fb::Data& d) {
+  cell::Award a;
+  a.call_id(text(d, "call_id"));
+  a.resource_id(text(d, "resource_id"));
+  a.order_id(text(d, "order_id"));
+  a.lease(fb::get_or<double>(d, "lease", 0));
+  return a;
+}
+
+fb::Data to_data(const cell::AwardReply& r) {
+  return {{"call_id", r.call_id()}, {"resource_id", r.resource_id()}, {"confirmed", r.confirmed()},
+          {"reason", r.reason()},   {"ahead", std::int64_t(r.ahead())}};
+}
+
+cell::AwardReply to_award_reply(const fb::Data& d) {
+  cell::AwardReply r;
+  r.call_id(text(d, "call_id"));
+  r.resource_id(text(d, "resource_id"));
+  r.confirmed(fb::get_or<bool>(d, "confirmed", false));
+  r.reason(text(d, "reason"));
+  r.ahead(static_cast<int32_t>(fb::get_or<std::int64_t>(d, "ahead", 0)));
+  return r;
+}
+
+fb::Data to_data(const cell::Release& r) { return {{"order_id", r.order_id()}, {"resource_id", r.resource_id()}}; }
+
+cell::Release to_release(const fb::Data& d) {
+  cell::Release r;
+  r.order_id(text(d, "order_id"));
+  r.resource_id(text(d, "resource_id"));
+  return r;
+}
+
+fb::Data to_data(const cell::Capability& c) {
+  return {{"resource_id", c.resource_id()},
+          {"kind", c.kind()},
+          {"operations", fb::join_names(c.operations())},
+          {"position", to_numbers(c.position())},
+          {"dock", to_numbers(c.dock())},
+          {"speed", c.speed()},
+          {"angular_speed", c.angular_speed()},
+          {"reserved_by", c.reserved_by()},
+          {"waiting", fb::join_names(c.waiting())},
+          {"queued_commands", std::int64_t(c.queued_commands())},
+          {"busy", c.busy()}};
 }
 
 }  // namespace dds

@@ -18,7 +18,9 @@ cell::Vec3 vec3(double x, double y, double z);
 
 }  // namespace dds
 
+#include "capabilities.h"
 #include "commands.h"
+#include "negotiation.h"
 #include "simulation.h"
 
 namespace dds {
@@ -32,5 +34,22 @@ fb::Data to_data(const cell::SimReply& reply);
 cell::SimRequest to_sim_request(const fb::Data& data);  // carried: comma-separated body ids
 fb::Data to_data(const cell::SimRequest& request);
 cell::SimReply to_sim_reply(const fb::Data& data);
+
+
+// The contract net's messages, as the Contractor and Negotiator blocks take them; lists
+// (a fetch batch's sources) as comma-separated names.
+fb::Data to_data(const cell::CallForProposals& call);
+cell::CallForProposals to_call(const fb::Data& data);
+fb::Data to_data(const cell::Proposal& proposal);
+cell::Proposal to_proposal(const fb::Data& data);
+fb::Data to_data(const cell::Award& award);
+cell::Award to_award(const fb::Data& data);
+fb::Data to_data(const cell::AwardReply& reply);
+cell::AwardReply to_award_reply(const fb::Data& data);
+fb::Data to_data(const cell::Release& release);
+cell::Release to_release(const fb::Data& data);
+// resource_id, kind, operations (comma-separated), position, dock, speed, angular_speed,
+// reserved_by, waiting (comma-separated), queued_commands, busy.
+fb::Data to_data(const cell::Capability& capability);
 
 }  // namespace dds

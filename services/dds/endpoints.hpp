@@ -49,6 +49,7 @@ class Writer : private fdds::DataWriterListener {
     if (!writer_) throw std::runtime_error("cannot create a writer on " + topic);
   }
   ~Writer() override {
+    writer_->set_listener(nullptr);
     publisher_->delete_datawriter(writer_);
     participant_->delete_publisher(publisher_);
   }
@@ -93,8 +94,13 @@ class Reader : private fdds::DataReaderListener {
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic);
   }
+  // A listener callback already under way finishes first; later ones find the reader closed.
   ~Reader() override {
     reader_->set_listener(nullptr);
+    {
+      std::lock_guard<std::mutex> lock(drain_mutex_);
+      closed_ = true;
+    }
     subscriber_->delete_datareader(reader_);
     participant_->delete_subscriber(subscriber_);
   }
@@ -117,6 +123,7 @@ class Reader : private fdds::DataReaderListener {
   // NOT_ALIVE) the kept sample tells which instance it was; then take it.
   void drain(fdds::DataReader* reader) {
     std::lock_guard<std::mutex> lock(drain_mutex_);
+    if (closed_) return;
     fdds::LoanableSequence<T> samples;
     fdds::SampleInfoSeq infos;
     const auto visit = [&](auto&& each) {
@@ -145,6 +152,7 @@ class Reader : private fdds::DataReaderListener {
   std::function<void(const T&)> on_sample_;
   std::function<void(const T&)> on_gone_;
   std::mutex drain_mutex_;
+  bool closed_ = false;
   fdds::Subscriber* subscriber_ = nullptr;
   fdds::DataReader* reader_ = nullptr;
 };

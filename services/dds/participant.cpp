@@ -5,7 +5,6 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
-#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
 namespace dds {
@@ -17,8 +16,12 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
   qos.name(name);
   if (settings.localhost_only) {
+    // UDP on loopback only, no shared memory: Fast DDS 2.9.1's SHM transport drops messages
+    // silently (a full port, a port of a process killed hard whose number a new process
+    // reuses, a sender's full segment) and, once two processes see each other's SHM
+    // locators, carries their discovery over SHM alone. Lost discovery and liveliness
+    // messages were the multi-second discovery tail and a live buffer declared gone.
     qos.transport().use_builtin_transports = false;
-    qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
     udp->interfaceWhiteList.emplace_back("127.0.0.1");
     // The initial peer 127.0.0.1 stands for the discovery ports of participants 0..N-1 on

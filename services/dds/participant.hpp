@@ -1,7 +1,8 @@
 #pragma once
 // DDS participants for the cell. Localhost-only unless the deployment says otherwise:
-// built-in transports off, shared memory plus UDPv4 restricted to 127.0.0.1, and 127.0.0.1
-// as the initial discovery peer. With that, Fast DDS 2.9 sends nothing but loopback traffic.
+// built-in transports off, UDPv4 restricted to 127.0.0.1 (no shared memory: see
+// participant.cpp), and 127.0.0.1 as the initial discovery peer. With that, Fast DDS 2.9
+// sends nothing but loopback traffic.
 
 #include <memory>
 #include <string>

@@ -14,7 +14,7 @@ namespace dds {
 enum class TopicKind { state, events };
 
 struct QosSettings {
-  double liveliness_lease_s = 2.0;  // a state writer silent this long is taken for dead
+  double liveliness_lease_s = 5.0;  // a state writer silent this long is taken for dead
 };
 
 eprosima::fastdds::dds::DataWriterQos writer_qos(TopicKind kind, const QosSettings& settings = {});

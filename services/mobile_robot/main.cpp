@@ -25,9 +25,13 @@ void stop(int) { running = 0; }
 int main(int argc, char** argv) {
   CLI::App app{"mobile-robot: fetches parts from buffers to the station"};
   dds::ParticipantSettings dds;
-  services::NodeConfig config{"mobile-robot-1", "mobile-robot"};
+  services::NodeConfig config;
+  config.id = "mobile-robot-1";
+  config.kind = "mobile-robot";
   config.speed = 0.8;
   config.when_busy = fb::CommandLifecycle::WhenBusy::queue;
+  config.offers = {"fetch"};
+  config.exclusive = false;  // hired per batch of fetches: its queue holds several orders' work
   bool all_interfaces = false;
   dds::add_dds_options(app, dds, all_interfaces);
   app.add_option("--id", config.id, "Resource id");
@@ -43,8 +47,12 @@ int main(int argc, char** argv) {
     fb::Resource resource(config.id, 1024);
     auto& robot = resource.add(std::make_unique<fb::MobileRobotBlock>(
         "robot", config.id, fb::Numbers(config.position.begin(), config.position.end()), config.speed));
-    services::ResourceNode node(resource, participant, config, robot,
-                                [](const std::string& op, const std::string&) { return op == "fetch"; });
+    const auto estimate = [&robot](const fb::Data& call) {
+      const auto e = robot.estimate(fb::split_names(fb::get_or<std::string>(call, "sources", "")),
+                                    fb::get_or<std::string>(call, "station", ""));
+      return fb::Contractor::Estimate{e.known, e.known ? "" : "no dock known for '" + e.unknown_place + "'", e.duration};
+    };
+    services::ResourceNode node(resource, participant, config, robot, estimate);
     auto& places = resource.add(std::make_unique<dds::SubscribeBlock<cell::Capability, cell::CapabilityPubSubType>>(
         "places", participant, "cell/capabilities", dds::TopicKind::state, [](const cell::Capability& c) {
           return fb::Data{{"resource_id", c.resource_id()}, {"dock", dds::to_numbers(c.dock())}};

@@ -1,10 +1,13 @@
 #include "services/mobile_robot/mobile_robot_block.hpp"
 
+#include <cmath>
+
 namespace fb {
 
 MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers home, double speed)
-    : DeviceBlock(std::move(name), id, {"fetch"}, "INIT"), sim_(id), speed_(speed) {
+    : DeviceBlock(std::move(name), id, {"fetch"}, "INIT"), sim_(id), speed_(speed), work_ends_at_(home) {
   declare_input("INIT");
+  declare_input("AWARDED", {"sources", "station"});
   declare_input("PLACE", {"resource_id", "dock"});
   declare_input("SIM_REPLY", {"request_id", "ok"});
   declare_input("GIVE_EVENT", {"command_id", "state", "reason"});
@@ -35,6 +38,10 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   for (const char* state : {"INIT", "SPAWNING", "READY", "TO_SOURCE", "WAIT_GIVE", "TO_DESTINATION"}) {
     transition(state, "PLACE", state, [this](const Data& d) {
       docks_[get<std::string>(d, "resource_id")] = get<Numbers>(d, "dock");
+    });
+    transition(state, "AWARDED", state, [this](const Data& d) {
+      const auto it = docks_.find(get<std::string>(d, "station"));
+      if (it != docks_.end()) work_ends_at_ = it->second;
     });
   }
   transition("INIT", "INIT", "SPAWNING", [this, home](const Data&) {
@@ -81,6 +88,24 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
 void MobileRobotBlock::drive_to(const std::string& place, const std::vector<std::string>& carried) {
   const Numbers& dock = docks_.at(place);
   emit("SIM", sim_.move(body(), carried, {dock[0], 0, dock[2], 1, 0, 0, 0}, speed_, 0));
+}
+
+
+MobileRobotBlock::Estimate MobileRobotBlock::estimate(const std::vector<std::string>& sources,
+                                                      const std::string& destination) const {
+  Estimate e;
+  const auto distance = [](const Numbers& a, const Numbers& b) { return std::hypot(a[0] - b[0], a[2] - b[2]); };
+  Numbers at = work_ends_at_;
+  if (!docks_.count(destination)) return {false, destination, 0};
+  const Numbers& to = docks_.at(destination);
+  for (const auto& source : sources) {
+    const auto it = docks_.find(source);
+    if (it == docks_.end()) return {false, source, 0};
+    e.duration += (distance(at, it->second) + distance(it->second, to)) / speed_;
+    at = to;
+  }
+  e.known = true;
+  return e;
 }
 
 }  // namespace fb

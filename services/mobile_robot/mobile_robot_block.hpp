@@ -9,6 +9,8 @@
 //     -> SIM move to the source's dock -> GIVE (a "give" command to the source)
 //     -> GIVE_EVENT succeeded -> SIM move to the destination's dock carrying the part -> DONE
 //   PLACE (resource_id, dock): where a resource hands parts over
+//   AWARDED (sources, station): a batch of fetches it was hired for; it will end there
+// estimate(): how long a batch would take from where its work taken on so far ends.
 
 #include <map>
 
@@ -21,6 +23,14 @@ class MobileRobotBlock : public DeviceBlock {
  public:
   MobileRobotBlock(std::string name, std::string resource_id, Numbers home, double speed);
 
+  // Driving to each source and on to the destination, s; a refusal when a place is unknown.
+  struct Estimate {
+    bool known = false;
+    std::string unknown_place;
+    double duration = 0;
+  };
+  Estimate estimate(const std::vector<std::string>& sources, const std::string& destination) const;
+
  private:
   void drive_to(const std::string& place, const std::vector<std::string>& carried);
   std::string body() const { return resource_id() + "/base"; }
@@ -28,6 +38,7 @@ class MobileRobotBlock : public DeviceBlock {
   SimRequests sim_;
   double speed_;
   std::map<std::string, Numbers> docks_;
+  Numbers work_ends_at_;  // where the last batch taken on ends
   Data fetch_;          // the command being executed
   std::string give_id_;
   double distance_ = 0, moving_ = 0;  // so far in this fetch

@@ -34,6 +34,7 @@ void DeviceBlock::receive(const Event& event) {
   }
   if (event.name == "ORDER_ENDED") {
     ended_orders_.insert(get<std::string>(event.data, "order_id"));
+    order_ended(get<std::string>(event.data, "order_id"));
     return;
   }
   if (event.name == "ORDER_ACTIVE") {

@@ -34,6 +34,10 @@ class DeviceBlock : public BasicBlock {
 
   void receive(const Event& event) override;
 
+ protected:
+  // An order ended (done, failed, its twin gone): a device frees what it kept for it.
+  virtual void order_ended(const std::string& /*order*/) {}
+
  private:
   std::string resource_id_;
   std::set<std::string> operations_;

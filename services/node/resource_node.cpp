@@ -41,6 +41,7 @@ struct ResourceNode::Impl {
   Pub<cell::SimRequest, cell::SimRequestPubSubType>* sim_requests = nullptr;
   fb::CommandLifecycle* lifecycle = nullptr;
   bool busy = false;  // as last published
+  std::size_t queued_published = 0;
 
   Impl(fb::Resource& r, dds::ParticipantPtr p, NodeConfig c, fb::DeviceBlock& d)
       : resource(r), participant(p), config(std::move(c)), device(d), clock(p) {}
@@ -57,17 +58,21 @@ struct ResourceNode::Impl {
     resource.add(std::make_unique<Pub<T, P>>(name, participant, topic, TopicKind::events, std::move(to_sample)));
   }
 
-  void publish_capability() const {
+  void publish_capability() {
     cell::Capability c;
     c.resource_id(config.id);
     c.kind(config.kind);
-    c.operations(std::vector<std::string>(device.operations().begin(), device.operations().end()));
+    std::set<std::string> operations = device.operations();
+    operations.insert(config.offers.begin(), config.offers.end());
+    c.operations(std::vector<std::string>(operations.begin(), operations.end()));
     c.position(dds::vec3(config.position[0], config.position[1], config.position[2]));
     c.dock(dds::vec3(config.dock[0], config.dock[1], config.dock[2]));
     c.reach(config.reach);
     c.speed(config.speed);
     c.angular_speed(config.angular_speed);
     c.reserved_by(contractor->reserved_by());
+    c.waiting(contractor->waiting());
+    c.queued_commands(static_cast<int32_t>(lifecycle->queued()));
     c.busy(busy);
     if (describe) describe(c);
     capabilities->write(c);
@@ -91,8 +96,10 @@ struct ResourceNode::Impl {
     if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
     e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
     if (is_final(state)) device.forget(id);
-    if ((lifecycle->state() != "IDLE") != busy) {
-      busy = !busy;
+    const std::size_t queued = lifecycle->queued();
+    if ((lifecycle->state() != "IDLE") != busy || queued != queued_published) {
+      busy = lifecycle->state() != "IDLE";
+      queued_published = queued;
       publish_capability();
     }
     return e;
@@ -100,7 +107,8 @@ struct ResourceNode::Impl {
 };
 
 ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participant, NodeConfig config,
-                           fb::DeviceBlock& device, fb::Contractor::CanServe can_serve, std::function<void(cell::Capability&)> describe)
+                           fb::DeviceBlock& device, fb::Contractor::EstimateFn estimate,
+                           std::function<void(cell::Capability&)> describe)
     : impl_(std::make_unique<Impl>(resource, participant, std::move(config), device)) {
   Impl& n = *impl_;
   n.describe = std::move(describe);
@@ -131,51 +139,33 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   }
 
   // The contract net.
-  n.contractor = &resource.add(std::make_unique<fb::Contractor>("contractor", n.config.id, n.config.exclusive,
-                                                                std::move(can_serve)));
+  n.contractor = &resource.add(std::make_unique<fb::Contractor>("contractor", n.config.id, n.config.offers, n.config.exclusive,
+                                                                std::move(estimate), [&n] { return n.clock.now(); }));
   n.subscribe<cell::CallForProposals, cell::CallForProposalsPubSubType>(
-      "calls", "cell/negotiation/calls", TopicKind::events, [](const cell::CallForProposals& c) {
-        return fb::Data{{"call_id", c.call_id()}, {"order_id", c.order_id()}, {"operation", c.operation()},
-                        {"part_type", c.part_type()}};
-      });
+      "calls", "cell/negotiation/calls", TopicKind::events, [](const cell::CallForProposals& c) { return dds::to_data(c); });
   n.subscribe<cell::Award, cell::AwardPubSubType>("awards", "cell/negotiation/awards", TopicKind::events,
-                                                  [](const cell::Award& a) {
-                                                    return fb::Data{{"call_id", a.call_id()},
-                                                                    {"resource_id", a.resource_id()},
-                                                                    {"order_id", a.order_id()}};
-                                                  });
+                                                  [](const cell::Award& a) { return dds::to_data(a); });
   n.subscribe<cell::Release, cell::ReleasePubSubType>("releases", "cell/negotiation/releases", TopicKind::events,
-                                                      [](const cell::Release& r) {
-                                                        return fb::Data{{"order_id", r.order_id()},
-                                                                        {"resource_id", r.resource_id()}};
-                                                      });
+                                                      [](const cell::Release& r) { return dds::to_data(r); });
   auto& orders = dds::watch_orders(resource, participant);
   n.starters.push_back([&orders] { orders.start(); });
   resource.connect("calls", "IND", "contractor", "CFP");
   resource.connect("awards", "IND", "contractor", "AWARD");
   resource.connect("releases", "IND", "contractor", "RELEASE");
+  resource.connect("lifecycle", "IDLE", "contractor", "IDLE");
   resource.connect("order_watch", "ENDED", "contractor", "ORDER_ENDED");
   resource.connect("order_watch", "ENDED", dev, "ORDER_ENDED");
   resource.connect("order_watch", "ACTIVE", dev, "ORDER_ACTIVE");
+  if (device.has_input("AWARDED")) resource.connect("contractor", "AWARDED", dev, "AWARDED");
   const std::string id = n.config.id;
-  n.publish<cell::Proposal, cell::ProposalPubSubType>("proposals", "cell/negotiation/proposals",
-                                                      [id](const fb::Data& d) {
-                                                        cell::Proposal p;
-                                                        p.call_id(fb::get<std::string>(d, "call_id"));
-                                                        p.resource_id(id);
-                                                        p.earliest_start(fb::get<double>(d, "earliest_start"));
-                                                        p.duration(fb::get<double>(d, "duration"));
-                                                        return p;
-                                                      });
-  n.publish<cell::AwardReply, cell::AwardReplyPubSubType>("award_replies", "cell/negotiation/replies",
-                                                          [id](const fb::Data& d) {
-                                                            cell::AwardReply r;
-                                                            r.call_id(fb::get<std::string>(d, "call_id"));
-                                                            r.resource_id(id);
-                                                            r.confirmed(fb::get<bool>(d, "confirmed"));
-                                                            r.reason(fb::get<std::string>(d, "reason"));
-                                                            return r;
-                                                          });
+  n.publish<cell::Proposal, cell::ProposalPubSubType>("proposals", "cell/negotiation/proposals", [id](fb::Data d) {
+    d["resource_id"] = id;
+    return dds::to_proposal(d);
+  });
+  n.publish<cell::AwardReply, cell::AwardReplyPubSubType>("award_replies", "cell/negotiation/replies", [id](fb::Data d) {
+    d["resource_id"] = id;
+    return dds::to_award_reply(d);
+  });
   resource.connect("contractor", "PROPOSE", "proposals", "REQ");
   resource.connect("contractor", "REPLY", "award_replies", "REQ");
   resource.add(std::make_unique<fb::ActionBlock>("capability", [this](const fb::Data&) { publish_capability(); }));

@@ -7,6 +7,7 @@
 //
 //   cell/commands --> device.COMMAND --> lifecycle --> cell/command_events
 //   cell/negotiation/* and cell/orders/status --> contractor --> proposals, replies, capability
+//   (the holder and the queue of waiting orders), device.AWARDED
 //   device.SIM --> cell/sim/requests;  cell/sim/replies --> device.SIM_REPLY
 //   device.CAPABILITY --> cell/capabilities (e.g. a buffer's stock changed)
 //
@@ -38,18 +39,19 @@ struct NodeConfig {
   double speed = 0;          // m/s
   double angular_speed = 0;  // rad/s
   double reach = 0;          // m
-  bool exclusive = true;     // reserved by one order at a time
-  double liveliness_lease_s = 2.0;
+  std::set<std::string> offers;  // operations it bids for in the contract net ("host", "fetch", ...)
+  bool exclusive = true;     // held by one order at a time; others wait in its queue
+  double liveliness_lease_s = 5.0;
   fb::CommandLifecycle::WhenBusy when_busy = fb::CommandLifecycle::WhenBusy::reject;
 };
 
 class ResourceNode {
  public:
-  // `device` must already be on `resource`. `can_serve` decides which calls for proposals
-  // it answers; `describe` adds to the capability what only the device knows (a stock).
+  // `device` must already be on `resource`. `estimate` answers calls for proposals (a bid
+  // or a refusal with the reason); `describe` adds to the capability what only the device
+  // knows (a stock). A device with an AWARDED input hears of the work it was awarded.
   ResourceNode(fb::Resource& resource, dds::ParticipantPtr participant, NodeConfig config, fb::DeviceBlock& device,
-               fb::Contractor::CanServe can_serve,
-               std::function<void(cell::Capability&)> describe = {});
+               fb::Contractor::EstimateFn estimate, std::function<void(cell::Capability&)> describe = {});
   ~ResourceNode();
 
   // Starts listening to the topics; call once everything is wired. A device that moves

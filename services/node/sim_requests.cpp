@@ -8,12 +8,19 @@ Data SimRequests::request(const std::string& kind, const std::string& body) {
 }
 
 Data SimRequests::spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents,
-                        bool is_static, const std::string& mesh_uri) {
+                        bool is_static, const std::string& mesh_uri, const std::string& scene) {
   Data d = request("spawn", body);
   d["placement"] = placement;
   d["half_extents"] = half_extents;
   d["is_static"] = is_static;
   d["mesh_uri"] = mesh_uri;
+  d["scene"] = scene;
+  return d;
+}
+
+Data SimRequests::spawn_fixture(const std::string& body, const Numbers& placement, const Numbers& half_extents) {
+  Data d = spawn(body, placement, half_extents, true);
+  d["fixture"] = true;
   return d;
 }
 

@@ -13,8 +13,11 @@ class SimRequests {
  public:
   explicit SimRequests(std::string requester) : requester_(std::move(requester)) {}
 
+  // `scene`: where the body lives ("" the physical cell, else a virtual scene).
   Data spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents, bool is_static,
-             const std::string& mesh_uri = "");
+             const std::string& mesh_uri = "", const std::string& scene = "");
+  // A static body of the cell that every scene sees (a station's table).
+  Data spawn_fixture(const std::string& body, const Numbers& placement, const Numbers& half_extents);
   Data remove(const std::string& body);
   Data set_static(const std::string& body, bool is_static);
   Data move(const std::string& body, const std::vector<std::string>& carried, const Numbers& path, double speed,

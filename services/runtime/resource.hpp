@@ -27,6 +27,11 @@ class EventQueueOverflow : public std::runtime_error {
 class Resource {
  public:
   Resource(std::string name, std::size_t queue_capacity);
+  // Closes the queue before the blocks go: a DDS listener thread that posts while the
+  // resource is torn down finds it closed instead of a half-destroyed map of blocks.
+  ~Resource();
+  Resource(const Resource&) = delete;
+  Resource& operator=(const Resource&) = delete;
 
   const std::string& name() const { return name_; }
   // The resource owns its blocks. Returns the block for connecting and inspection.
@@ -41,7 +46,8 @@ class Resource {
   // from.output -> to.input; both must be declared. Throws std::logic_error otherwise.
   void connect(const std::string& from, const std::string& output, const std::string& to, const std::string& input);
 
-  // Queues an event for a block's input. Thread-safe. Throws EventQueueOverflow when full.
+  // Queues an event for a block's input. Thread-safe. Throws EventQueueOverflow when full;
+  // does nothing once the resource is closing.
   void post(const std::string& block, const std::string& input, Data data = {});
 
   // Delivers one queued event; false when the queue was empty.
@@ -70,6 +76,7 @@ class Resource {
   mutable std::mutex mutex_;
   std::condition_variable ready_;
   std::deque<Delivery> queue_;
+  bool closed_ = false;
   std::atomic<std::size_t> refused_{0};
 };
 

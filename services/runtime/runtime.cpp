@@ -77,6 +77,15 @@ void BasicBlock::receive(const Event& event) {
 
 Resource::Resource(std::string name, std::size_t queue_capacity) : name_(std::move(name)), capacity_(queue_capacity) {}
 
+Resource::~Resource() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_ = true;
+    queue_.clear();
+  }
+  blocks_.clear();  // subscribe blocks stop their DDS readers here
+}
+
 void Resource::adopt(std::unique_ptr<FunctionBlock> block) {
   if (blocks_.count(block->name())) throw std::logic_error(name_ + " has a block " + block->name() + " already");
   block->resource_ = this;
@@ -108,10 +117,11 @@ void Resource::enqueue(FunctionBlock& target, Event event) {
 }
 
 void Resource::post(const std::string& name, const std::string& input, Data data) {
-  FunctionBlock& target = block(name);
-  if (!target.has_input(input)) throw std::logic_error(name + " has no event input " + input);
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return;
+    FunctionBlock& target = block(name);
+    if (!target.has_input(input)) throw std::logic_error(name + " has no event input " + input);
     enqueue(target, {input, std::move(data)});
   }
   ready_.notify_one();

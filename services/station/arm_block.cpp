@@ -1,7 +1,5 @@
 #include "services/station/arm_block.hpp"
 
-#include <Eigen/Geometry>
-
 namespace fb {
 
 ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
@@ -74,28 +72,15 @@ void ArmBlock::request(Data data) { emit("SIM", std::move(data)); }
 void ArmBlock::grip(const Data& d) {
   error_.clear();
   const Numbers& pose = get<Numbers>(d, "path");
-  const Numbers& size = get<Numbers>(d, "size");
-  const Numbers& push = get<Numbers>(d, "direction");
-  // The carriage runs behind the pad, against the push, along its main axis.
-  int axis = 0;
-  Eigen::Vector3d(push[0], push[1], push[2]).cwiseAbs().maxCoeff(&axis);
-  const double sign = push[axis] > 0 ? 1.0 : -1.0;
-  Numbers carriage_half(3, settings_.carriage_width / 2);
-  carriage_half[axis] = settings_.carriage_length / 2;
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  offset[axis] = -sign * (size[axis] + settings_.carriage_length / 2);
-  // The offset is in the pad's frame: turn it by the pad's orientation.
-  offset = Eigen::Quaterniond(pose[3], pose[4], pose[5], pose[6]).normalized() * offset;
-  Numbers carriage_pose = pose;
-  for (int i = 0; i < 3; ++i) carriage_pose[i] += offset[i];
+  const Carriage carriage_body = carriage_behind(pose, get<Numbers>(d, "size"), get<Numbers>(d, "direction"), settings_.gripper);
   awaited_ = 2;
   if (has_gripper_) {
     awaited_ += 2;
     request(sim_.remove(pad()));
     request(sim_.remove(carriage()));
   }
-  request(sim_.spawn(pad(), pose, size, false));
-  request(sim_.spawn(carriage(), carriage_pose, carriage_half, false));
+  request(sim_.spawn(pad(), pose, get<Numbers>(d, "size"), false));
+  request(sim_.spawn(carriage(), carriage_body.pose, carriage_body.half_extents, false));
   has_gripper_ = true;
   held_ = get<std::string>(d, "part");
 }

@@ -12,6 +12,7 @@
 //   SIM_REPLY: cell-sim's answers; SIM: requests to cell-sim
 
 #include "services/node/device_block.hpp"
+#include "services/node/gripper.hpp"
 #include "services/node/sim_requests.hpp"
 
 namespace fb {
@@ -19,8 +20,7 @@ namespace fb {
 struct ArmSettings {
   double speed = 0.25;          // m/s
   double angular_speed = 1.0;   // rad/s
-  double carriage_width = 0.020;
-  double carriage_length = 0.150;
+  GripperSize gripper;
 };
 
 class ArmBlock : public DeviceBlock {

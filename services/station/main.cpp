@@ -22,7 +22,13 @@ void stop(int) { running = 0; }
 int main(int argc, char** argv) {
   CLI::App app{"station: the assembly station and its robot arm"};
   dds::ParticipantSettings dds;
-  services::NodeConfig station{"station-1", "station"}, arm{"arm-1", "arm"};
+  services::NodeConfig station, arm;
+  station.id = "station-1";
+  station.kind = "station";
+  arm.id = "arm-1";
+  arm.kind = "arm";
+  station.offers = {"host"};
+  arm.offers = {"translate"};
   std::array<double, 3> table{1.0, 0.025, 1.0};
   fb::ArmSettings arm_settings;
   bool all_interfaces = false;
@@ -51,11 +57,18 @@ int main(int argc, char** argv) {
         "station", station.id, fb::Numbers(station.position.begin(), station.position.end()),
         fb::Numbers(table.begin(), table.end())));
     auto& arm_block = arm_resource.add(std::make_unique<fb::ArmBlock>("arm", arm.id, arm_settings));
-    services::ResourceNode station_node(station_resource, participant, station, station_block,
-                                        [](const std::string& op, const std::string&) { return op == "host"; });
-    services::ResourceNode arm_node(arm_resource, participant, arm, arm_block, [&](const std::string& op, const std::string&) {
-      return arm_block.operations().count(op) > 0;
-    });
+    // Both are held by one order at a time, for as long as it says it needs them; the arm
+    // only by an order that works at its station.
+    const auto hold = [](const fb::Data& call) {
+      return fb::Contractor::Estimate{true, "", fb::get_or<double>(call, "duration", 0)};
+    };
+    const auto hold_arm = [&station, &arm, hold](const fb::Data& call) {
+      const std::string at = fb::get_or<std::string>(call, "station", "");
+      if (at != station.id) return fb::Contractor::Estimate{false, arm.id + " works at " + station.id + ", not " + at, 0};
+      return hold(call);
+    };
+    services::ResourceNode station_node(station_resource, participant, station, station_block, hold);
+    services::ResourceNode arm_node(arm_resource, participant, arm, arm_block, hold_arm);
     station_node.start();
     arm_node.start();
     station_resource.post("station", "INIT");

@@ -9,7 +9,7 @@ StationBlock::StationBlock(std::string name, std::string id, Numbers position, N
   declare_output("SIM", {"request_id", "kind", "body_id"});
   transition("INIT", "INIT", "SPAWNING", [this, position, half](const Data&) {
     const Numbers table{position[0], position[1] - half[1], position[2], 1, 0, 0, 0};
-    emit("SIM", sim_.spawn(this->resource_id() + "/table", table, half, true));
+    emit("SIM", sim_.spawn_fixture(this->resource_id() + "/table", table, half));
   });
   transition("SPAWNING", "SIM_REPLY", "READY", {},
              [this](const Data& d) { return sim_.answers_last(d) && get<bool>(d, "ok"); });

@@ -58,7 +58,8 @@ void WorldBlock::handle(const fb::Data& d) {
     if (kind == "spawn") {
       const fb::Numbers& h = fb::get<fb::Numbers>(d, "half_extents");
       world_.spawn({id, fb::get<std::string>(d, "mesh_uri"), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
-                    pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get<bool>(d, "is_static")});
+                    pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get<bool>(d, "is_static"),
+                    fb::get_or<std::string>(d, "scene", ""), fb::get_or<bool>(d, "fixture", false)});
       owner_[id] = fb::get<std::string>(d, "requester");
     } else if (kind == "remove") {
       world_.remove(id);

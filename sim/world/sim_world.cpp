@@ -3,7 +3,19 @@
 #include <algorithm>
 
 namespace sim {
-SimWorld::SimWorld(CollisionOptions options) : world_(options) {}
+SimWorld::SimWorld(CollisionOptions options) : options_(options) { scene(""); }
+
+// A new virtual scene starts with every fixture of the cell in it.
+SimWorld::Scene& SimWorld::scene(const std::string& name) {
+  auto [it, created] = scenes_.try_emplace(name);
+  if (created) {
+    it->second.world = std::make_unique<CollisionWorld>(options_);
+    for (auto& [id, b] : bodies_) {
+      if (b.spec.fixture && b.spec.is_static) add_obstacle(b, name);
+    }
+  }
+  return it->second;
+}
 
 SimWorld::Body& SimWorld::body(const std::string& id) {
   const auto it = bodies_.find(id);
@@ -14,7 +26,10 @@ SimWorld::Body& SimWorld::body(const std::string& id) {
 void SimWorld::spawn(const BodySpec& spec) {
   if (spec.id.empty()) throw SimError("a body needs an id");
   if (bodies_.count(spec.id)) throw SimError("body " + spec.id + " exists already");
-  Body body{spec, nullptr, std::nullopt};
+  if (spec.fixture && !(spec.is_static && spec.scene.empty())) {
+    throw SimError("fixture " + spec.id + " must be static and in the physical cell");
+  }
+  Body body{spec, nullptr, {}};
   if (!spec.mesh_uri.empty()) {
     try {
       body.mesh = meshes_.get(spec.mesh_uri);
@@ -22,22 +37,41 @@ void SimWorld::spawn(const BodySpec& spec) {
       throw SimError("body " + spec.id + ": " + e.what());
     }
   }
+  ++scene(spec.scene).bodies;
   if (spec.is_static) add_obstacle(body);
   bodies_.emplace(spec.id, std::move(body));
 }
 
 void SimWorld::add_obstacle(Body& body) {
-  if (body.mesh) {
-    body.obstacle = world_.add_static_mesh(body.spec.id, body.mesh, body.spec.pose);
-  } else if (!body.spec.half_extents.isZero()) {
-    body.obstacle = world_.add_static_box(body.spec.id, body.spec.half_extents, body.spec.pose);
+  add_obstacle(body, body.spec.scene);
+  if (body.spec.fixture) {
+    for (const auto& [name, s] : scenes_) {
+      if (!name.empty()) add_obstacle(body, name);
+    }
   }
+}
+
+void SimWorld::add_obstacle(Body& body, const std::string& scene_name) {
+  CollisionWorld& world = *scene(scene_name).world;
+  if (body.mesh) {
+    body.obstacle[scene_name] = world.add_static_mesh(body.spec.id, body.mesh, body.spec.pose);
+  } else if (!body.spec.half_extents.isZero()) {
+    body.obstacle[scene_name] = world.add_static_box(body.spec.id, body.spec.half_extents, body.spec.pose);
+  }
+}
+
+void SimWorld::remove_obstacle(Body& body) {
+  for (const auto& [name, id] : body.obstacle) scenes_.at(name).world->remove(id);
+  body.obstacle.clear();
 }
 
 void SimWorld::remove(const std::string& id) {
   Body& b = body(id);
-  if (b.obstacle) world_.remove(*b.obstacle);
+  remove_obstacle(b);
+  const std::string scene_name = b.spec.scene;
   bodies_.erase(id);
+  // A virtual scene goes with its last body.
+  if (--scenes_.at(scene_name).bodies == 0 && !scene_name.empty()) scenes_.erase(scene_name);
 }
 
 void SimWorld::set_static(const std::string& id, bool is_static) {
@@ -46,9 +80,8 @@ void SimWorld::set_static(const std::string& id, bool is_static) {
   b.spec.is_static = is_static;
   if (is_static) {
     add_obstacle(b);
-  } else if (b.obstacle) {
-    world_.remove(*b.obstacle);
-    b.obstacle.reset();
+  } else {
+    remove_obstacle(b);
   }
 }
 
@@ -58,11 +91,15 @@ MoveResult SimWorld::move(const MoveRequest& request) {
   for (const auto& id : request.carried) moving.push_back(&body(id));
   for (const Body* b : moving) {
     if (b->spec.is_static) throw SimError("body " + b->spec.id + " is static: set it movable before moving it");
+    if (b->spec.scene != moving.front()->spec.scene) {
+      throw SimError("body " + b->spec.id + " is in another scene than " + request.body);
+    }
   }
+  const CollisionWorld& world = *scenes_.at(moving.front()->spec.scene).world;
   // One compound in the frame of the moving body, each member at its offset now.
   const Pose start = moving.front()->spec.pose;
   MovingBody compound;
-  const double margin = world_.options().shape_margin;
+  const double margin = options_.shape_margin;
   std::vector<Pose> offsets;
   for (const Body* b : moving) {
     const Pose offset = offsets.emplace_back(start.inverse() * b->spec.pose);
@@ -81,7 +118,7 @@ MoveResult SimWorld::move(const MoveRequest& request) {
     const double duration =
         std::max(length / request.speed, request.angular_speed > 0 ? angle / request.angular_speed : 0.0);
     std::optional<Contact> contact;
-    if (!compound.empty()) contact = world_.sweep(compound, at, next);
+    if (!compound.empty()) contact = world.sweep(compound, at, next);
     const double done = contact ? contact->fraction : 1.0;
     result.distance += done * length;
     result.duration += done * duration;

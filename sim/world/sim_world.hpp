@@ -4,6 +4,12 @@
 // obstacles, and motions of one body with the bodies it carries along a path, in simulated
 // time from speeds, stopped at the first collision with a static body. No DDS here: the
 // cell-sim process serves this over topics.
+//
+// Bodies live in scenes: "" is the physical cell; any other name is a virtual scene (an
+// order's virtual assembly) whose moves meet only that scene's static bodies and the cell's
+// fixtures (static bodies of the physical cell spawned as fixtures: the stations' tables).
+// So many orders assemble virtually at once, at the same station, without meeting each
+// other or the parts that stand on the station for real.
 
 #include <map>
 #include <optional>
@@ -26,6 +32,8 @@ struct BodySpec {
   Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();       // a box; neither: no shape
   Pose pose = Pose::Identity();
   bool is_static = false;
+  std::string scene;     // "" the physical cell
+  bool fixture = false;  // static, in the physical cell, and seen from every scene
 };
 
 struct MoveRequest {
@@ -50,7 +58,7 @@ class SimWorld {
   explicit SimWorld(CollisionOptions options = {});
 
   // Each throws SimError with the reason: an id taken or unknown, a mesh that cannot be read,
-  // a move of a static body.
+  // a move of a static body, a move that carries a body of another scene.
   void spawn(const BodySpec& body);
   void remove(const std::string& id);
   void set_static(const std::string& id, bool is_static);
@@ -60,18 +68,27 @@ class SimWorld {
   std::optional<Pose> pose(const std::string& id) const;
   bool is_static(const std::string& id) const;
   std::size_t size() const { return bodies_.size(); }
+  std::size_t scenes() const { return scenes_.size(); }  // the physical cell and virtual ones with bodies
 
  private:
   struct Body {
     BodySpec spec;
     std::shared_ptr<const TriangleMesh> mesh;
-    std::optional<BodyId> obstacle;  // in the collision world while static
+    std::map<std::string, BodyId> obstacle;  // scene -> its id in that scene's collision world, while static
+  };
+  struct Scene {
+    std::unique_ptr<CollisionWorld> world;
+    std::size_t bodies = 0;
   };
   Body& body(const std::string& id);
+  Scene& scene(const std::string& name);
   void add_obstacle(Body& body);
+  void add_obstacle(Body& body, const std::string& scene);
+  void remove_obstacle(Body& body);
 
-  CollisionWorld world_;
+  CollisionOptions options_;
   MeshCache meshes_;
+  std::map<std::string, Scene> scenes_;
   std::map<std::string, Body> bodies_;
 };
 

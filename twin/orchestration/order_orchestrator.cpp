@@ -14,12 +14,13 @@ Pose with_translation(Pose pose, double x, double y, double z) {
   return pose;
 }
 
-bool turns(const std::vector<Pose>& path) {
-  for (const Pose& p : path) {
-    if (!p.linear().isApprox(path.front().linear(), 1e-9)) return true;
-  }
-  return false;
+double path_length(const std::vector<Pose>& poses) {
+  double length = 0;
+  for (std::size_t i = 1; i < poses.size(); ++i) length += (poses[i].translation() - poses[i - 1].translation()).norm();
+  return length;
 }
+
+const std::string kHost = "host", kArm = "arm", kRobot = "robot", kGive = "give/";
 
 }  // namespace
 
@@ -29,79 +30,85 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       settings_(std::move(settings)), sim_(settings_.order_id) {
   declare_input("START");
   declare_input("TICK");
-  declare_input("CAPABILITY", {"resource_id", "dock", "position"});
+  declare_input("CAPABILITY", {"resource_id", "kind", "position", "dock", "speed", "angular_speed", "reserved_by",
+                               "waiting"});
   declare_input("RESOURCE_GONE", {"resource_id"});
-  declare_input("PROPOSAL", {"call_id", "resource_id"});
-  declare_input("AWARD_REPLY", {"call_id", "resource_id", "confirmed", "reason"});
+  declare_input("AWARDED", {"call_id", "resource_id", "ahead"});
+  declare_input("UNAVAILABLE", {"call_id", "reason"});
   declare_input("COMMAND_EVENT", {"command_id", "order_id", "state", "reason"});
   declare_input("SIM_REPLY", {"request_id", "ok", "error", "collided"});
-  for (const char* out : {"CFP", "AWARD", "RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
+  declare_output("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
+  for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
   declare_output("FINISHED", {"complete", "error"});
 
-  needs_ = {{"host", "", "", ""}, {"translate", "", "", ""}, {"fetch", "", "", ""}};
-  std::set<std::string> types;
-  for (const auto& step : plan_.steps) types.insert(short_type_name(product_.product.parts()[step.part].type));
-  for (const auto& type : types) needs_.push_back({"give", type, "", ""});
-
-  // Where resources are, in every state.
-  for (const char* state : {"IDLE", "NEGOTIATING", "RUNNING", "ENDED"}) {
-    transition(state, "CAPABILITY", state, [this](const Data& d) {
-      docks_[get<std::string>(d, "resource_id")] = get<Numbers>(d, "dock");
-      positions_[get<std::string>(d, "resource_id")] = get<Numbers>(d, "position");
+  const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
+                              "HIRING", "PHYSICAL",     "CLEANUP", "ENDED"};
+  // What the cell's resources say of themselves, in every state.
+  for (const char* in : all_states) {
+    transition(in, "CAPABILITY", in, [this](const Data& d) {
+      Place& p = places_[get<std::string>(d, "resource_id")];
+      p = {get<std::string>(d, "kind"), get<Numbers>(d, "position"), get<Numbers>(d, "dock"), get<double>(d, "speed"),
+           get<double>(d, "angular_speed"), get<std::string>(d, "reserved_by"),
+           fb::split_names(get<std::string>(d, "waiting"))};
+      const std::string& id = get<std::string>(d, "resource_id");
+      if (state() == "WAITING_CELL") try_begin_virtual();
+      if (state() == "QUEUED" && id == station_) on_queue_news(p);
+      if (state() == "HIRING" && id == arm_ && p.reserved_by == settings_.order_id) {
+        arm_held_ = true;
+        start_physical_when_hired();
+      }
     });
   }
 
-  transition("IDLE", "START", "NEGOTIATING", [this](const Data&) {
-    phase_started_ = std::chrono::steady_clock::now();
-    status("NEGOTIATING", "calling for proposals", 0);
-    call_for_proposals();
+  transition("IDLE", "START", "WAITING_CELL", [this](const Data&) {
+    waiting_since_ = std::chrono::steady_clock::now();
+    status("PLANNING", "planned " + std::to_string(plan_.steps.size()) + " steps; waiting for a station of the cell", 0);
+    try_begin_virtual();
   });
-  transition("NEGOTIATING", "TICK", "NEGOTIATING", [this](const Data&) {
-    if (start_when_negotiated()) return;
-    if (std::chrono::steady_clock::now() - phase_started_ < settings_.wait_timeout) return call_for_proposals();
-    std::string missing;
-    for (const Need& n : needs_) {
-      if (n.awarded.empty()) missing += (missing.empty() ? "" : ", ") + n.operation + (n.part_type.empty() ? "" : " " + n.part_type);
-    }
-    std::string known;
-    for (const auto& [id, dock] : docks_) known += (known.empty() ? "" : ", ") + id;
-    fail("waited " + std::to_string(settings_.wait_timeout.count() / 1000) + " s and no resource offered: " + missing +
-         " (resources seen: " + (known.empty() ? "none" : known) +
-         "; is the cell up, are the parts in a buffer, is another order holding the station?)");
-  });
-  transition("NEGOTIATING", "PROPOSAL", "NEGOTIATING", [this](const Data& d) {
-    for (Need& n : needs_) {
-      if (settings_.order_id + "/" + n.operation + "/" + n.part_type != get<std::string>(d, "call_id")) continue;
-      if (!n.awarded.empty() || !n.pending.empty()) return;
-      n.pending = get<std::string>(d, "resource_id");
-      emit("AWARD", {{"call_id", get<std::string>(d, "call_id")}, {"resource_id", n.pending},
-                     {"order_id", settings_.order_id}, {"lease", settings_.award_lease_s}});
-    }
-  });
-  transition("NEGOTIATING", "AWARD_REPLY", "NEGOTIATING", [this](const Data& d) {
-    for (Need& n : needs_) {
-      if (settings_.order_id + "/" + n.operation + "/" + n.part_type != get<std::string>(d, "call_id")) continue;
-      if (n.pending != get<std::string>(d, "resource_id")) return;
-      if (get<bool>(d, "confirmed")) n.awarded = n.pending;
-      n.pending.clear();  // refused: called again at the next tick
-    }
-    start_when_negotiated();
-  });
-  transition("NEGOTIATING", "RESOURCE_GONE", "NEGOTIATING", [this](const Data& d) {
-    for (Need& n : needs_) {
-      if (n.pending == get<std::string>(d, "resource_id")) n.pending.clear();
-      if (n.awarded == get<std::string>(d, "resource_id")) n.awarded.clear();
+  transition("WAITING_CELL", "TICK", "WAITING_CELL", [this](const Data&) {
+    if (waited_too_long()) {
+      fail("no station of the cell appeared within " + std::to_string(settings_.wait_timeout.count() / 1000) +
+           " s: is the cell up?");
     }
   });
 
-  transition("RUNNING", "SIM_REPLY", "RUNNING", [this](const Data& d) {
-    if (!action_running_ || get<std::string>(d, "request_id") != awaited_id_) return;
-    if (get<bool>(d, "ok") || phase_ == "cleanup") return action_done();
-    fail("cell-sim refused: " + get<std::string>(d, "error"));
-  });
-  transition("RUNNING", "COMMAND_EVENT", "RUNNING", [this](const Data& d) {
+  // Cell-sim's answers, in the states that send it requests.
+  for (const char* in : {"VIRTUAL", "PHYSICAL", "CLEANUP"}) {
+    transition(in, "SIM_REPLY", in, [this](const Data& d) {
+      if (!action_running_ || get<std::string>(d, "request_id") != awaited_id_) return;
+      if (state() == "CLEANUP") return action_done();
+      if (!get<bool>(d, "ok")) return fail("cell-sim refused: " + get<std::string>(d, "error"));
+      if (fb::get_or<bool>(d, "collided", false) && actions_.front().retry_on_collision) {
+        std::string reason;
+        fb::move_outcome(d, reason);
+        return on_collision(reason);
+      }
+      action_done();
+    });
+  }
+
+  // Booking a station, then hiring what physical assembly needs there.
+  for (const char* in : {"BOOKING", "QUEUED", "HIRING"}) {
+    transition(in, "AWARDED", in, [this](const Data& d) { on_awarded(d); });
+    transition(in, "UNAVAILABLE", in, [this](const Data& d) { fail(get<std::string>(d, "reason")); });
+  }
+  transition("QUEUED", "RESOURCE_GONE", "BOOKING", [this](const Data&) {
+    awarded_.erase(station_);
+    emit("FINDING", {{"kind", std::string("rebooked")},
+                     {"message", station_ + " disappeared while the order waited for it; booking another station"},
+                     {"part", std::string()}});
+    book();
+  }, [this](const Data& d) { return get<std::string>(d, "resource_id") == station_; });
+  for (const char* in : {"HIRING", "PHYSICAL"}) {
+    transition(in, "RESOURCE_GONE", in, [this](const Data& d) {
+      const std::string& id = get<std::string>(d, "resource_id");
+      if (awarded_.count(id)) fail(id + " disappeared (its liveliness lease ran out)");
+    });
+  }
+
+  transition("PHYSICAL", "COMMAND_EVENT", "PHYSICAL", [this](const Data& d) {
     if (get<std::string>(d, "order_id") != settings_.order_id) return;
     const std::string& id = get<std::string>(d, "command_id");
     const std::string& state = get<std::string>(d, "state");
@@ -109,7 +116,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       if (state == "succeeded") {
         delivered_.insert(id);
         if (action_running_ && actions_.front().kind == Action::await_delivery && awaited_id_ == id) action_done();
-      } else if (state == "aborted" && phase_ != "cleanup") {
+      } else if (state == "aborted") {
         fail("fetching " + product_.product.parts()[fetch->second].name + " failed: " + get<std::string>(d, "reason"));
       }
       return;
@@ -117,56 +124,145 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     if (!action_running_ || id != awaited_id_) return;
     if (state == "succeeded") return action_done();
     if (state != "aborted") return;
-    if (phase_ == "cleanup") return action_done();
-    if (actions_.front().retry_on_collision) return on_collision(get<std::string>(d, "reason"));
     fail(fb::get_or<std::string>(d, "resource_id", "") + " " + get<std::string>(actions_.front().data, "operation") +
          " failed: " + get<std::string>(d, "reason"));
   });
-  transition("RUNNING", "RESOURCE_GONE", "RUNNING", [this](const Data& d) {
-    const std::string& id = get<std::string>(d, "resource_id");
-    const bool ours = std::any_of(needs_.begin(), needs_.end(), [&](const Need& n) { return n.awarded == id; });
-    if (ours && phase_ != "cleanup") fail(id + " disappeared (its liveliness lease ran out)");
+  transition("CLEANUP", "COMMAND_EVENT", "CLEANUP", [this](const Data& d) {
+    if (action_running_ && get<std::string>(d, "command_id") == awaited_id_ &&
+        get<std::string>(d, "state") != "accepted" && get<std::string>(d, "state") != "executing") {
+      action_done();
+    }
   });
-  transition("RUNNING", "TICK", "RUNNING", [this](const Data&) {
-    if (phase_ == "cleanup" && std::chrono::steady_clock::now() - phase_started_ > settings_.cleanup_timeout) finish();
+  transition("CLEANUP", "TICK", "CLEANUP", [this](const Data&) {
+    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) finish();
   });
 }
 
-// --- negotiation ---------------------------------------------------------------------------
+// --- booking and hiring --------------------------------------------------------------------
 
-void OrderOrchestrator::call_for_proposals() {
-  for (const Need& n : needs_) {
-    if (!n.awarded.empty() || !n.pending.empty()) continue;
-    emit("CFP", {{"call_id", settings_.order_id + "/" + n.operation + "/" + n.part_type},
-                 {"order_id", settings_.order_id}, {"operation", n.operation}, {"part_type", n.part_type}});
+bool OrderOrchestrator::waited_too_long() const {
+  return std::chrono::steady_clock::now() - waiting_since_ > settings_.wait_timeout;
+}
+
+// Virtual assembly happens at a station's place (any: it sees the fixtures, not the station's
+// work), in the order's own scene.
+void OrderOrchestrator::try_begin_virtual() {
+  for (const auto& [id, p] : places_) {
+    if (p.kind == "arm" && p.speed > 0) {
+      settings_.arm_speed = p.speed;
+      settings_.arm_angular_speed = p.angular_speed;
+    }
+    if (p.kind == "station" && virtual_station_.empty()) virtual_station_ = id;
   }
-}
-
-// Every need awarded, and where each awarded resource hands parts over known.
-bool OrderOrchestrator::negotiated() const {
-  return std::all_of(needs_.begin(), needs_.end(), [this](const Need& n) { return docks_.count(n.awarded) > 0; });
-}
-
-const std::string& OrderOrchestrator::awarded(const std::string& operation, const std::string& part_type) const {
-  for (const Need& n : needs_) {
-    if (n.operation == operation && n.part_type == part_type) return n.awarded;
-  }
-  throw std::logic_error("no need " + operation + " " + part_type);
-}
-
-bool OrderOrchestrator::start_when_negotiated() {
-  if (!negotiated()) return false;
-  enter("RUNNING");
-  phase_started_ = std::chrono::steady_clock::now();
+  if (virtual_station_.empty()) return;
+  enter("VIRTUAL");
   status("VIRTUAL_ASSEMBLY", "virtual assembly in cell-sim", 0);
   step_ = candidate_ = 0;
-  if (plan_.steps.empty()) {
-    plan_physical();
-  } else {
-    add_candidate(0, 0);
-    next_action();
+  if (plan_.steps.empty()) return book();
+  add_candidate(0, 0);
+  next_action();
+}
+
+double OrderOrchestrator::physical_estimate() const {
+  const Numbers dock = places_.count(virtual_station_) ? places_.at(virtual_station_).dock : Numbers{0.6, 0, 0};
+  double length = 0;
+  for (const auto& step : plan_.steps) {
+    const auto& w = step.trajectory.waypoints;
+    std::vector<Pose> poses;
+    for (const auto& p : w) poses.push_back(p.gripper);
+    // From the dock to where the trajectory starts, along it, and back to the dock.
+    const double to_start = (w.front().part.translation() - Vec3(dock[0], dock[1], dock[2])).norm();
+    length += 2 * to_start + path_length(poses);
   }
-  return true;
+  return length / settings_.arm_speed;
+}
+
+void OrderOrchestrator::book() {
+  enter("BOOKING");
+  ahead_ = -1;
+  waiting_since_ = std::chrono::steady_clock::now();
+  status("WAITING", "virtual assembly done; booking a station", 0);
+  emit("CALL", {{"call_id", settings_.order_id + "/" + kHost}, {"operation", kHost}, {"part_type", std::string()},
+                {"station", std::string()}, {"sources", std::string()}, {"count", std::int64_t(0)},
+                {"duration", physical_estimate()}});
+}
+
+void OrderOrchestrator::on_queue_news(const Place& station) {
+  if (station.reserved_by == settings_.order_id) return hire();
+  const auto it = std::find(station.waiting.begin(), station.waiting.end(), settings_.order_id);
+  if (it == station.waiting.end()) return;  // not in the queue yet (the award's reply was quicker)
+  const long ahead = 1 + (it - station.waiting.begin());
+  if (ahead == ahead_) return;
+  ahead_ = ahead;
+  status("WAITING", "waiting for " + station_ + ": " + std::to_string(ahead) + (ahead == 1 ? " order" : " orders") +
+                        " ahead", 0);
+}
+
+std::map<std::string, int> OrderOrchestrator::parts_per_type() const {
+  std::map<std::string, int> out;
+  for (const auto& step : plan_.steps) ++out[short_type_name(product_.product.parts()[step.part].type)];
+  return out;
+}
+
+void OrderOrchestrator::hire() {
+  enter("HIRING");
+  status("WAITING", station_ + " is ours; hiring its arm, a mobile robot and buffers", 0);
+  const auto call = [this](const std::string& what, const std::string& operation, const std::string& type, long count,
+                           double duration) {
+    emit("CALL", {{"call_id", settings_.order_id + "/" + what}, {"operation", operation}, {"part_type", type},
+                  {"station", station_}, {"sources", std::string()}, {"count", std::int64_t(count)},
+                  {"duration", duration}});
+  };
+  call(kArm, "translate", "", 0, physical_estimate());
+  for (const auto& [type, count] : parts_per_type()) call(kGive + type, "give", type, count, 0);
+  hire_robot_when_ready();
+}
+
+void OrderOrchestrator::on_awarded(const Data& d) {
+  const std::string what = get<std::string>(d, "call_id").substr(settings_.order_id.size() + 1);
+  const std::string& resource = get<std::string>(d, "resource_id");
+  awarded_.insert(resource);
+  const long ahead = static_cast<long>(get<std::int64_t>(d, "ahead"));
+  if (what == kHost) {
+    station_ = resource;
+    if (ahead == 0) return hire();
+    enter("QUEUED");
+    on_queue_news(places_[station_]);
+    if (ahead_ < 0) {
+      ahead_ = ahead;
+      status("WAITING", "waiting for " + station_ + ": " + std::to_string(ahead) + (ahead == 1 ? " order" : " orders") +
+                            " ahead", 0);
+    }
+    return;
+  }
+  if (what == kArm) {
+    arm_ = resource;
+    arm_held_ = ahead == 0 || places_[arm_].reserved_by == settings_.order_id;
+  } else if (what == kRobot) {
+    robot_ = resource;
+  } else if (what.rfind(kGive, 0) == 0) {
+    buffer_of_[what.substr(kGive.size())] = resource;
+    hire_robot_when_ready();
+  }
+  start_physical_when_hired();
+}
+
+// The robot's bid depends on where it fetches from: it is called once every buffer is known.
+void OrderOrchestrator::hire_robot_when_ready() {
+  if (!robot_.empty() || buffer_of_.size() < parts_per_type().size()) return;
+  std::vector<std::string> sources;
+  for (const auto& step : plan_.steps) {
+    sources.push_back(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
+  }
+  emit("CALL", {{"call_id", settings_.order_id + "/" + kRobot}, {"operation", std::string("fetch")},
+                {"part_type", std::string()}, {"station", station_}, {"sources", fb::join_names(sources)},
+                {"count", std::int64_t(sources.size())}, {"duration", 0.0}});
+}
+
+void OrderOrchestrator::start_physical_when_hired() {
+  if (state() != "HIRING" || robot_.empty() || arm_.empty() || !arm_held_) return;
+  enter("PHYSICAL");
+  plan_physical();
 }
 
 // --- scripts -------------------------------------------------------------------------------
@@ -178,8 +274,8 @@ std::vector<Trajectory> OrderOrchestrator::candidates(std::size_t step) const {
   return out;
 }
 
-Pose OrderOrchestrator::at_station(const Pose& pose) const {
-  const Numbers& p = positions_.at(awarded("host"));
+Pose OrderOrchestrator::at(const std::string& station, const Pose& pose) const {
+  const Numbers& p = places_.at(station).position;
   Pose offset = Pose::Identity();
   offset.translation() = Vec3(p[0], p[1], p[2]);
   return offset * pose;
@@ -207,38 +303,35 @@ Data OrderOrchestrator::command(const std::string& resource, const std::string& 
           {"resource_id", resource}, {"order_id", settings_.order_id}, {"operation", operation}, {"part", part}};
 }
 
-// Grip, move along the pads' poses while holding, release, back out, connect.
-void OrderOrchestrator::add_trajectory_moves(const std::string& body, const std::vector<Pose>& holding,
-                                             const std::vector<Pose>& retreat, bool retry) {
-  const std::string& arm = awarded("translate");
-  Data move = command(arm, turns(holding) ? "rotate" : "translate", body);
-  move["path"] = pose_numbers(holding);
-  actions_.push_back({Action::command, move, retry});
-  actions_.push_back({Action::command, command(arm, "release", body)});
-  Data back = command(arm, "translate", body);
-  back["path"] = pose_numbers(retreat);
-  actions_.push_back({Action::command, back, retry});
-  actions_.push_back({Action::command, command(arm, "connect", body)});
-}
-
+// Virtual assembly of one candidate trajectory, all in cell-sim: the part and a gripper of
+// the arm's shape in the order's scene, the gripper moved with the part, then backing out.
 void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
-  phase_ = "virtual";
   const PartIndex part = plan_.steps[step].part;
   const Trajectory t = candidates(step)[candidate];
-  const std::string body = virtual_body(part);
+  const std::string body = virtual_body(part), pad = settings_.order_id + "/virtual/gripper-pad",
+                    carriage = settings_.order_id + "/virtual/gripper-carriage";
+  const std::string& scene = settings_.order_id;
   const auto& w = t.waypoints;
-  actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at_station(w.front().part)}), {0, 0, 0}, false,
-                                              product_.product.parts()[part].mesh->file.string())});
-  spawned_.insert(body);
-  Data grip = command(awarded("translate"), "grip", body);
-  grip["path"] = pose_numbers({at_station(w.front().gripper)});
-  const Vec3 pad = scene_.pad_half_extents(part, t.grip_direction);
-  grip["size"] = Numbers{pad.x(), pad.y(), pad.z()};
-  grip["direction"] = Numbers{t.grip_direction.x(), t.grip_direction.y(), t.grip_direction.z()};
-  actions_.push_back({Action::command, grip});
+  actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at(virtual_station_, w.front().part)}), {0, 0, 0},
+                                              false, product_.product.parts()[part].mesh->file.string(), scene)});
+  const Numbers grasp = pose_numbers({at(virtual_station_, w.front().gripper)});
+  const Vec3 half = scene_.pad_half_extents(part, t.grip_direction);
+  const Numbers pad_half{half.x(), half.y(), half.z()};
+  const fb::Carriage c = fb::carriage_behind(grasp, pad_half, {t.grip_direction.x(), t.grip_direction.y(),
+                                                               t.grip_direction.z()}, settings_.gripper);
+  actions_.push_back({Action::sim, sim_.spawn(pad, grasp, pad_half, false, "", scene)});
+  actions_.push_back({Action::sim, sim_.spawn(carriage, c.pose, c.half_extents, false, "", scene)});
+  spawned_.insert({body, pad, carriage});
   std::vector<Pose> holding, retreat;
-  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at_station(w[i].gripper));
-  add_trajectory_moves(body, holding, retreat, true);
+  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
+  const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
+  actions_.push_back({Action::sim, sim_.move(pad, {carriage, body}, pose_numbers(holding), v, omega), true});
+  if (!retreat.empty()) actions_.push_back({Action::sim, sim_.move(pad, {carriage}, pose_numbers(retreat), v, omega), true});
+  actions_.push_back({Action::sim, sim_.set_static(body, true)});
+  for (const auto& gripper : {pad, carriage}) {
+    actions_.push_back({Action::sim, sim_.remove(gripper)});
+    spawned_.erase(gripper);
+  }
 }
 
 void OrderOrchestrator::on_collision(const std::string& reason) {
@@ -250,10 +343,11 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
                    {"part", name}});
   actions_.clear();
   action_running_ = false;
-  const std::string body = virtual_body(part);
-  actions_.push_back({Action::command, command(awarded("translate"), "release", body)});
-  actions_.push_back({Action::sim, sim_.remove(body)});
-  spawned_.erase(body);
+  for (const auto& body : {virtual_body(part), settings_.order_id + "/virtual/gripper-pad",
+                           settings_.order_id + "/virtual/gripper-carriage"}) {
+    actions_.push_back({Action::sim, sim_.remove(body)});
+    spawned_.erase(body);
+  }
   if (++candidate_ >= all.size()) return back_to_sequence_planning();
   add_candidate(step_, candidate_);
   next_action();
@@ -289,33 +383,39 @@ void OrderOrchestrator::back_to_sequence_planning() {
   next_action();
 }
 
+// Grip, move along the pads' poses while holding, release, back out, connect.
+void OrderOrchestrator::add_arm_moves(const std::string& body, const std::vector<Pose>& holding,
+                                      const std::vector<Pose>& retreat) {
+  const bool turns = std::any_of(holding.begin(), holding.end(),
+                                 [&](const Pose& p) { return !p.linear().isApprox(holding.front().linear(), 1e-9); });
+  Data move = command(arm_, turns ? "rotate" : "translate", body);
+  move["path"] = pose_numbers(holding);
+  actions_.push_back({Action::command, move});
+  actions_.push_back({Action::command, command(arm_, "release", body)});
+  Data back = command(arm_, "translate", body);
+  back["path"] = pose_numbers(retreat);
+  actions_.push_back({Action::command, back});
+  actions_.push_back({Action::command, command(arm_, "connect", body)});
+}
+
 void OrderOrchestrator::plan_physical() {
-  phase_ = "physical";
-  phase_started_ = std::chrono::steady_clock::now();
-  status("PHYSICAL_ASSEMBLY", "virtual assembly done; physical assembly", 0);
-  for (const std::string& body : std::set<std::string>(spawned_)) {
-    actions_.push_back({Action::sim, sim_.remove(body)});
-    spawned_.erase(body);
-  }
-  const std::string& station = awarded("host");
-  const std::string& robot = awarded("fetch");
-  const std::string& arm = awarded("translate");
-  const Numbers& dock = docks_.at(station);
+  status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_, 0);
+  const Numbers& dock = places_.at(station_).dock;
   std::vector<std::string> fetches;
   for (const auto& step : plan_.steps) {
     const auto& part = product_.product.parts()[step.part];
     const std::string type = short_type_name(part.type);
-    const std::string& buffer = awarded("give", type);
-    const Numbers& source = docks_.at(buffer);
-    const Pose final_pose = at_station(part.final_pose);
+    const std::string& buffer = buffer_of_.at(type);
+    const Numbers& source = places_.at(buffer).dock;
+    const Pose final_pose = at(station_, part.final_pose);
     const std::string body = physical_body(step.part);
     const Pose in_buffer = with_translation(final_pose, source[0], final_pose.translation().y(), source[2]);
     actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, part.mesh->file.string())});
     spawned_.insert(body);
-    Data fetch = command(robot, "fetch", body);
+    Data fetch = command(robot_, "fetch", body);
     fetch["part_type"] = type;
     fetch["source"] = buffer;
-    fetch["destination"] = station;
+    fetch["destination"] = station_;
     fetch_of_[get<std::string>(fetch, "command_id")] = step.part;
     fetches.push_back(get<std::string>(fetch, "command_id"));
     actions_.push_back({Action::send_only, fetch});
@@ -328,13 +428,13 @@ void OrderOrchestrator::plan_physical() {
     actions_.push_back({Action::await_delivery, {{"command_id", fetches[i]}}});
     // Delivered at the dock; carried up, over to where the trajectory starts, then along it.
     const Pose grip = w.front().part.inverse() * w.front().gripper;
-    const Pose start = at_station(w.front().part);
-    const Pose delivered = with_translation(start, dock[0], at_station(product_.product.parts()[part].final_pose).translation().y(), dock[2]);
+    const Pose start = at(station_, w.front().part);
+    const Pose delivered =
+        with_translation(start, dock[0], at(station_, product_.product.parts()[part].final_pose).translation().y(), dock[2]);
     const double safe = std::max(delivered.translation().y(), start.translation().y());
-    std::vector<Pose> part_path = {
-        with_translation(delivered, dock[0], safe, dock[2]),
-        with_translation(start, start.translation().x(), safe, start.translation().z()), start};
-    Data take = command(arm, "grip", body);
+    std::vector<Pose> part_path = {with_translation(delivered, dock[0], safe, dock[2]),
+                                   with_translation(start, start.translation().x(), safe, start.translation().z()), start};
+    Data take = command(arm_, "grip", body);
     take["path"] = pose_numbers({delivered * grip});
     const Vec3 pad = scene_.pad_half_extents(part, t.grip_direction);
     take["size"] = Numbers{pad.x(), pad.y(), pad.z()};
@@ -342,15 +442,15 @@ void OrderOrchestrator::plan_physical() {
     actions_.push_back({Action::command, take});
     std::vector<Pose> holding, retreat;
     for (const Pose& p : part_path) holding.push_back(p * grip);
-    for (std::size_t k = 1; k < w.size(); ++k) (w[k].holding ? holding : retreat).push_back(at_station(w[k].gripper));
-    add_trajectory_moves(body, holding, retreat, false);
+    for (std::size_t k = 1; k < w.size(); ++k) (w[k].holding ? holding : retreat).push_back(at(station_, w[k].gripper));
+    add_arm_moves(body, holding, retreat);
   }
   next_action();
 }
 
 void OrderOrchestrator::plan_cleanup() {
-  phase_ = "cleanup";
-  phase_started_ = std::chrono::steady_clock::now();
+  enter("CLEANUP");
+  waiting_since_ = std::chrono::steady_clock::now();
   actions_.clear();
   action_running_ = false;
   for (const std::string& body : spawned_) actions_.push_back({Action::sim, sim_.remove(body)});
@@ -385,19 +485,25 @@ void OrderOrchestrator::next_action() {
     }
   }
   action_running_ = false;
-  if (phase_ == "virtual") {
-    plan_.steps[step_].trajectory = candidates(step_)[candidate_];
-    status("VIRTUAL_ASSEMBLY", "virtual assembly: " + std::to_string(step_ + 1) + " of " +
-                                   std::to_string(plan_.steps.size()) + " parts",
-           double(step_ + 1) / plan_.steps.size());
-    candidate_ = 0;
-    if (++step_ < plan_.steps.size()) {
-      add_candidate(step_, 0);
-      return next_action();
+  if (state() == "VIRTUAL") {
+    if (step_ < plan_.steps.size()) {
+      plan_.steps[step_].trajectory = candidates(step_)[candidate_];
+      status("VIRTUAL_ASSEMBLY", "virtual assembly: " + std::to_string(step_ + 1) + " of " +
+                                     std::to_string(plan_.steps.size()) + " parts",
+             double(step_ + 1) / plan_.steps.size());
+      candidate_ = 0;
+      if (++step_ < plan_.steps.size()) {
+        add_candidate(step_, 0);
+        return next_action();
+      }
+      // The virtual product leaves cell-sim; then the order books a station for the real one.
+      for (const std::string& body : spawned_) actions_.push_back({Action::sim, sim_.remove(body)});
+      spawned_.clear();
+      if (!actions_.empty()) return next_action();
     }
-    return plan_physical();
+    return book();
   }
-  if (phase_ == "physical") {
+  if (state() == "PHYSICAL") {
     status("PHYSICAL_ASSEMBLY", "physical assembly done", 1);
     return plan_cleanup();
   }
@@ -406,13 +512,14 @@ void OrderOrchestrator::next_action() {
 
 void OrderOrchestrator::action_done() {
   const Action& a = actions_.front();
-  if (phase_ == "physical" && a.kind == Action::command && get<std::string>(a.data, "operation") == "connect") {
-    const std::size_t done = std::count_if(actions_.begin(), actions_.end(), [](const Action& x) {
+  if (state() == "PHYSICAL" && a.kind == Action::command && get<std::string>(a.data, "operation") == "connect") {
+    const std::size_t left = std::count_if(actions_.begin(), actions_.end(), [](const Action& x) {
       return x.kind == Action::await_delivery;
     });
-    status("PHYSICAL_ASSEMBLY", "physical assembly: " + std::to_string(plan_.steps.size() - done) + " of " +
+    status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ + ": " +
+                                    std::to_string(plan_.steps.size() - left) + " of " +
                                     std::to_string(plan_.steps.size()) + " parts",
-           double(plan_.steps.size() - done) / plan_.steps.size());
+           double(plan_.steps.size() - left) / plan_.steps.size());
   }
   actions_.pop_front();
   action_running_ = false;
@@ -426,20 +533,16 @@ void OrderOrchestrator::fail(const std::string& reason) {
   for (const auto& [fetch, part] : fetch_of_) {
     if (!delivered_.count(fetch)) emit("CANCEL", {{"command_id", fetch}});
   }
-  if (state() == "NEGOTIATING" || state() == "IDLE") return finish();
-  enter("RUNNING");
   plan_cleanup();
 }
 
 void OrderOrchestrator::finish() {
   enter("ENDED");
-  for (const Need& n : needs_) {
-    if (!n.awarded.empty() && n.operation != "give") {
-      emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", n.awarded}});
-    }
+  for (const std::string& resource : awarded_) {
+    emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", resource}});
   }
   if (error_.empty()) {
-    status("DONE", "assembled " + std::to_string(plan_.steps.size()) + " parts", 1);
+    status("DONE", "assembled " + std::to_string(plan_.steps.size()) + " parts at " + station_, 1);
   } else {
     status("FAILED", error_, 0);
   }

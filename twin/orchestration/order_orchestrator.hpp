@@ -1,34 +1,42 @@
 #pragma once
 // One order's orchestration (the paper's Fig. 5 after planning), as an IEC 61499 basic block
-// driven by events, never waiting on a call:
+// driven by events, never waiting on a call. Its execution control chart:
 //
-//   NEGOTIATING  calls for proposals for every operation the order needs (the station to
-//                host it, the arm, the mobile robot, a buffer per part type), awards the
-//                first proposer, waits for confirmations; calls again every tick until
-//                `wait_timeout`, then fails with what nobody offered.
-//   VIRTUAL      virtual assembly in cell-sim: each part spawned where its trajectory
-//                starts, gripped, moved, released, the arm backs out, the part connected.
-//                A collision cell-sim reports is answered with the next trajectory the
-//                planner had for that part; none left: back to sequence planning from the
-//                parts assembled so far, with that part barred from coming next (another
-//                order); no order left fails the order.
-//   PHYSICAL     the virtual parts removed; every part spawned at its buffer's dock; the
-//                mobile robot's queue filled with fetches in planned order; for each step the
-//                arm waits for that part's delivery, grips it at the station's dock, carries
-//                it up and over to its trajectory, inserts, releases, backs out, connects.
+//   IDLE -START-> WAITING_CELL   until a station of the cell is known (bounded by `wait`)
+//   VIRTUAL      virtual assembly in cell-sim, in the order's own virtual scene (it meets
+//                the cell's fixtures and nothing of other orders, so many orders do this at
+//                once and hold no resource): each part spawned where its trajectory starts,
+//                a gripper pad and carriage spawned at the grasp, moved, the gripper backs
+//                out, the part becomes static. A collision is answered with the next
+//                trajectory the planner had for that part; none left: back to sequence
+//                planning from the parts assembled so far, with that part barred from coming
+//                next; no order left fails the order.
+//   BOOKING      a call for a station ("host", with how long physical assembly will hold it);
+//                the best bid wins (the Negotiator block does the contract net)
+//   QUEUED       the station confirmed a place in its queue: the order holds nothing and
+//                waits as long as the queue lasts ("waiting for station-1: 3 orders ahead");
+//                a station that disappears is booked again elsewhere
+//   HIRING       the station is held: calls for its arm, for a buffer per part type (with
+//                the count) and then for a mobile robot for the batch of fetches
+//   PHYSICAL     every part spawned at its buffer's dock; the hired robot's fetches in
+//                planned order; for each step the arm waits for that part's delivery, grips
+//                it at the station's dock, carries it up and over to its trajectory,
+//                inserts, releases, backs out, connects
 //   CLEANUP      the order's bodies leave cell-sim (the product leaves the station), then
-//   DONE/FAILED  reservations released; FINISHED.
+//   ENDED        everything released; FINISHED
+// A failure anywhere cancels undelivered fetches and goes through CLEANUP to ENDED.
 //
-// Every step is an action (a cell-sim request, a command, or waiting for a delivery) in a
-// queue; the next starts when the one before is answered.
+// No hold-and-wait: while it waits for a station the order holds nothing; once it holds a
+// station, everything else it needs is shared (robots, buffers) or belongs to that station
+// (its arm), so every wait is bounded.
 //
-//   inputs: START, TICK, CAPABILITY (resource_id, dock, position), RESOURCE_GONE
-//           (resource_id), PROPOSAL (call_id, resource_id), AWARD_REPLY (call_id,
-//           resource_id, confirmed, reason), COMMAND_EVENT (command_id, order_id, state,
-//           reason), SIM_REPLY (request_id, ok, error, collided, ...)
-//   outputs: CFP, AWARD, RELEASE, COMMAND, CANCEL (fetches not delivered when the order
-//            fails), SIM (the topics' fields), STATUS (state, message,
-//            progress), FINDING (kind, message, part), FINISHED (complete, error)
+//   inputs: START, TICK, CAPABILITY (resource_id, kind, position, dock, speed, angular_speed,
+//           reserved_by, waiting), RESOURCE_GONE (resource_id), AWARDED (call_id,
+//           resource_id, ahead), UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
+//           order_id, state, reason), SIM_REPLY (request_id, ok, error, collided, ...)
+//   outputs: CALL (to the Negotiator), RELEASE, COMMAND, CANCEL (fetches not delivered when
+//            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
+//            FINDING (kind, message, part), FINISHED (complete, error)
 
 #include <chrono>
 #include <deque>
@@ -37,6 +45,7 @@
 #include <string>
 #include <vector>
 
+#include "services/node/gripper.hpp"
 #include "services/node/sim_requests.hpp"
 #include "services/runtime/basic_block.hpp"
 #include "twin/planning/assembly_planner.hpp"
@@ -45,9 +54,11 @@ namespace twin {
 
 struct OrderSettings {
   std::string order_id;
-  std::chrono::milliseconds wait_timeout{30000};  // for resources to offer what the order needs
+  std::chrono::milliseconds wait_timeout{30000};  // for the cell, and for each call but a station's queue
   std::chrono::milliseconds cleanup_timeout{5000};
-  double award_lease_s = 10;
+  double arm_speed = 0.25;          // m/s: virtual assembly's moves, until an arm's capability says
+  double arm_angular_speed = 1.0;   // rad/s
+  fb::GripperSize gripper;
 };
 
 class OrderOrchestrator : public fb::BasicBlock {
@@ -58,6 +69,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   // back), each step done so far with the trajectory cell-sim validated.
   const Plan& plan() const { return plan_; }
   const std::string& error() const { return error_; }
+  // Arm time of physical assembly: how long the order will hold a station, s of sim time.
+  double physical_estimate() const;
 
  private:
   struct Action {
@@ -65,23 +78,27 @@ class OrderOrchestrator : public fb::BasicBlock {
     fb::Data data;
     bool retry_on_collision = false;  // a move of a candidate trajectory in virtual assembly
   };
-  struct Need {
-    std::string operation, part_type, awarded, pending;
+  struct Place {
+    std::string kind;
+    fb::Numbers position, dock;
+    double speed = 0, angular_speed = 0;
+    std::string reserved_by;
+    std::vector<std::string> waiting;
   };
 
-  // Negotiation.
-  void call_for_proposals();
-  bool negotiated() const;
-  // Enters RUNNING with virtual assembly once every need is awarded; false until then.
-  bool start_when_negotiated();
-  const std::string& awarded(const std::string& operation, const std::string& part_type = "") const;
+  // Booking and hiring.
+  void try_begin_virtual();
+  void book();
+  void on_queue_news(const Place& station);
+  void hire();
+  void on_awarded(const fb::Data& award);
+  void hire_robot_when_ready();
+  void start_physical_when_hired();
   // Scripts.
-  void plan_virtual_step();
   void add_candidate(std::size_t step, std::size_t candidate);
   void plan_physical();
   void plan_cleanup();
-  void add_trajectory_moves(const std::string& body, const std::vector<Pose>& holding_pads,
-                            const std::vector<Pose>& retreat_pads, bool retry);
+  void add_arm_moves(const std::string& body, const std::vector<Pose>& holding, const std::vector<Pose>& retreat);
   fb::Data command(const std::string& resource, const std::string& operation, const std::string& part = "");
   // Running them.
   void next_action();
@@ -93,26 +110,33 @@ class OrderOrchestrator : public fb::BasicBlock {
   void finish();
   void status(const std::string& state, const std::string& message, double progress);
   std::vector<Trajectory> candidates(std::size_t step) const;
-  Pose at_station(const Pose& pose) const;
+  Pose at(const std::string& station, const Pose& pose) const;
   fb::Numbers pose_numbers(const std::vector<Pose>& poses) const;
   std::string virtual_body(PartIndex part) const;
   std::string physical_body(PartIndex part) const;
+  std::map<std::string, int> parts_per_type() const;
+  bool waited_too_long() const;
 
   const LoadedProduct& product_;
   Plan plan_;
   AssemblyScene scene_;  // for the gripper's pad size per part and push
   OrderSettings settings_;
   fb::SimRequests sim_;
-  std::vector<Need> needs_;
-  std::map<std::string, fb::Numbers> docks_, positions_;
-  std::chrono::steady_clock::time_point phase_started_;
+  std::map<std::string, Place> places_;  // what capabilities say, by resource id
+  std::chrono::steady_clock::time_point waiting_since_;
   std::deque<Action> actions_;
   bool action_running_ = false;
   std::string awaited_id_;
   std::size_t command_count_ = 0;
   std::size_t step_ = 0, candidate_ = 0;
-  std::string phase_;  // "virtual", "physical", "cleanup"
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
+  std::string virtual_station_;
+  // Physical assembly: what was awarded.
+  std::string station_, arm_, robot_;
+  std::map<std::string, std::string> buffer_of_;  // part type -> buffer
+  std::set<std::string> awarded_;                 // every resource to release at the end
+  long ahead_ = -1;                               // in the station's queue, as last reported
+  bool arm_held_ = false;
   std::set<std::string> delivered_, spawned_;
   std::map<std::string, PartIndex> fetch_of_;
   std::string error_;

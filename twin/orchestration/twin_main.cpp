@@ -25,7 +25,7 @@
 #include "simulationPubSubTypes.h"
 #include "twin/geometry/product_loader.hpp"
 #include "twin/model/source_ref.hpp"
-#include "twin/orchestration/order_orchestrator.hpp"
+#include "twin/orchestration/order_network.hpp"
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/plan_json.hpp"
 
@@ -38,8 +38,8 @@ using dds::TopicKind;
 
 cell::OrderState order_state(const std::string& s) {
   static const std::map<std::string, cell::OrderState> states = {
-      {"SUBMITTED", cell::SUBMITTED}, {"PLANNING", cell::PLANNING}, {"NEGOTIATING", cell::PLANNING},
-      {"VIRTUAL_ASSEMBLY", cell::VIRTUAL_ASSEMBLY}, {"PHYSICAL_ASSEMBLY", cell::PHYSICAL_ASSEMBLY},
+      {"SUBMITTED", cell::SUBMITTED}, {"PLANNING", cell::PLANNING}, {"VIRTUAL_ASSEMBLY", cell::VIRTUAL_ASSEMBLY},
+      {"WAITING", cell::WAITING}, {"PHYSICAL_ASSEMBLY", cell::PHYSICAL_ASSEMBLY},
       {"DONE", cell::DONE}, {"FAILED", cell::FAILED}};
   return states.at(s);
 }
@@ -48,7 +48,7 @@ cell::OrderState order_state(const std::string& s) {
 struct Options {
   dds::ParticipantSettings dds;
   std::string order, product, out = ".", sequence = "search", path = "linear";
-  double wait_s = 30, lease_s = 2;
+  double wait_s = 30, lease_s = 5;
   bool verbose = false;
   bool quiet = false;
 };
@@ -132,20 +132,22 @@ class TwinProcess {
     std::ofstream(file) << twin::plan_json(product.product, plan).dump(2) << '\n';
   }
 
+  using Inputs = std::vector<std::pair<const char*, const char*>>;  // (block, input)
+
   template <class T, class P>
   void subscribe(fb::Resource& r, const std::string& name, const std::string& topic, TopicKind kind,
-                 std::function<fb::Data(const T&)> to_data, const char* ind, const char* gone = nullptr) {
+                 std::function<fb::Data(const T&)> to_data, const Inputs& on_sample, const Inputs& on_gone = {}) {
     auto& block = r.add(std::make_unique<dds::SubscribeBlock<T, P>>(name, participant_, topic, kind, std::move(to_data)));
-    r.connect(name, "IND", "orchestrator", ind);
-    if (gone) r.connect(name, "GONE", "orchestrator", gone);
+    for (const auto& [to, input] : on_sample) r.connect(name, "IND", to, input);
+    for (const auto& [to, input] : on_gone) r.connect(name, "GONE", to, input);
     starters_.push_back([&block] { block.start(); });
   }
   template <class T, class P>
-  dds::PublishBlock<T, P>& publish(fb::Resource& r, const std::string& name, const std::string& topic, const char* output,
-                                   std::function<T(const fb::Data&)> to_sample) {
+  dds::PublishBlock<T, P>& publish(fb::Resource& r, const std::string& name, const std::string& topic,
+                                   const char* from, const char* output, std::function<T(const fb::Data&)> to_sample) {
     auto& block = r.add(std::make_unique<dds::PublishBlock<T, P>>(name, participant_, topic, TopicKind::events,
                                                                   std::move(to_sample)));
-    r.connect("orchestrator", output, name, "REQ");
+    r.connect(from, output, name, "REQ");
     return block;
   }
 
@@ -154,23 +156,21 @@ class TwinProcess {
     twin::OrderSettings settings;
     settings.order_id = options_.order;
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
-    auto& orchestrator = r.add(std::make_unique<twin::OrderOrchestrator>("orchestrator", product, plan, settings));
-    const std::string order = options_.order;
+    fb::NegotiationSettings negotiation;
+    negotiation.wait = settings.wait_timeout;
+    auto& orchestrator = twin::add_order_network(r, product, plan, settings, negotiation);
 
     subscribe<cell::Capability, cell::CapabilityPubSubType>(
-        r, "capabilities", "cell/capabilities", TopicKind::state, [](const cell::Capability& c) {
-          return fb::Data{{"resource_id", c.resource_id()}, {"dock", dds::to_numbers(c.dock())},
-                          {"position", dds::to_numbers(c.position())}};
-        }, "CAPABILITY", "RESOURCE_GONE");
+        r, "capabilities", "cell/capabilities", TopicKind::state,
+        [](const cell::Capability& c) { return dds::to_data(c); },
+        {{"orchestrator", "CAPABILITY"}, {"negotiator", "CAPABILITY"}},
+        {{"orchestrator", "RESOURCE_GONE"}, {"negotiator", "RESOURCE_GONE"}});
     subscribe<cell::Proposal, cell::ProposalPubSubType>(
-        r, "proposals", "cell/negotiation/proposals", TopicKind::events, [](const cell::Proposal& p) {
-          return fb::Data{{"call_id", p.call_id()}, {"resource_id", p.resource_id()}};
-        }, "PROPOSAL");
+        r, "proposals", "cell/negotiation/proposals", TopicKind::events,
+        [](const cell::Proposal& p) { return dds::to_data(p); }, {{"negotiator", "PROPOSAL"}});
     subscribe<cell::AwardReply, cell::AwardReplyPubSubType>(
-        r, "award_replies", "cell/negotiation/replies", TopicKind::events, [](const cell::AwardReply& a) {
-          return fb::Data{{"call_id", a.call_id()}, {"resource_id", a.resource_id()}, {"confirmed", a.confirmed()},
-                          {"reason", a.reason()}};
-        }, "AWARD_REPLY");
+        r, "award_replies", "cell/negotiation/replies", TopicKind::events,
+        [](const cell::AwardReply& a) { return dds::to_data(a); }, {{"negotiator", "AWARD_REPLY"}});
     subscribe<cell::CommandEvent, cell::CommandEventPubSubType>(
         r, "command_events", "cell/command_events", TopicKind::events, [this](const cell::CommandEvent& e) {
           clock_.observe(e.sim_time());
@@ -178,52 +178,35 @@ class TwinProcess {
           return fb::Data{{"command_id", e.command_id()}, {"order_id", e.order_id()},
                           {"resource_id", e.resource_id()}, {"state", std::string(dds::state_name(e.state()))},
                           {"reason", e.reason()}};
-        }, "COMMAND_EVENT");
+        }, {{"orchestrator", "COMMAND_EVENT"}});
     subscribe<cell::SimReply, cell::SimReplyPubSubType>(
         r, "sim_replies", "cell/sim/replies", TopicKind::events, [this](const cell::SimReply& s) {
           clock_.observe(s.end_time());
           if (options_.verbose) std::cout << "  sim reply " << s.request_id() << " " << s.ok() << " " << s.error() << std::endl;
           return dds::to_data(s);
-        }, "SIM_REPLY");
+        }, {{"orchestrator", "SIM_REPLY"}});
 
     publish<cell::CallForProposals, cell::CallForProposalsPubSubType>(
-        r, "calls", "cell/negotiation/calls", "CFP", [](const fb::Data& d) {
-          cell::CallForProposals c;
-          c.call_id(fb::get<std::string>(d, "call_id"));
-          c.order_id(fb::get<std::string>(d, "order_id"));
-          c.operation(fb::get<std::string>(d, "operation"));
-          c.part_type(fb::get<std::string>(d, "part_type"));
-          return c;
-        });
-    publish<cell::Award, cell::AwardPubSubType>(r, "awards", "cell/negotiation/awards", "AWARD", [](const fb::Data& d) {
-      cell::Award a;
-      a.call_id(fb::get<std::string>(d, "call_id"));
-      a.resource_id(fb::get<std::string>(d, "resource_id"));
-      a.order_id(fb::get<std::string>(d, "order_id"));
-      a.lease(fb::get<double>(d, "lease"));
-      return a;
-    });
-    publish<cell::Release, cell::ReleasePubSubType>(r, "releases", "cell/negotiation/releases", "RELEASE",
-                                                    [](const fb::Data& d) {
-                                                      cell::Release x;
-                                                      x.order_id(fb::get<std::string>(d, "order_id"));
-                                                      x.resource_id(fb::get<std::string>(d, "resource_id"));
-                                                      return x;
-                                                    });
-    publish<cell::Command, cell::CommandPubSubType>(r, "commands", "cell/commands", "COMMAND", [this](const fb::Data& d) {
+        r, "calls", "cell/negotiation/calls", "negotiator", "CFP", [](const fb::Data& d) { return dds::to_call(d); });
+    publish<cell::Award, cell::AwardPubSubType>(r, "awards", "cell/negotiation/awards", "negotiator", "AWARD",
+                                                [](const fb::Data& d) { return dds::to_award(d); });
+    publish<cell::Release, cell::ReleasePubSubType>(r, "releases", "cell/negotiation/releases", "orchestrator",
+                                                    "RELEASE", [](const fb::Data& d) { return dds::to_release(d); });
+    publish<cell::Command, cell::CommandPubSubType>(r, "commands", "cell/commands", "orchestrator", "COMMAND",
+                                                    [this](const fb::Data& d) {
       cell::Command c = dds::to_command(d);
       c.sim_time(clock_.now());
       if (options_.verbose) std::cout << "  command " << c.command_id() << " to " << c.resource_id() << std::endl;
       return c;
     });
-    publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "CANCEL",
-                                                                [](const fb::Data& d) {
+    publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "orchestrator",
+                                                                "CANCEL", [](const fb::Data& d) {
                                                                   cell::CancelRequest c;
                                                                   c.command_id(fb::get<std::string>(d, "command_id"));
                                                                   return c;
                                                                 });
     auto& sim = publish<cell::SimRequest, cell::SimRequestPubSubType>(
-        r, "sim_requests", "cell/sim/requests", "SIM", [this](const fb::Data& d) {
+        r, "sim_requests", "cell/sim/requests", "orchestrator", "SIM", [this](const fb::Data& d) {
           if (options_.verbose) std::cout << "  sim " << fb::get<std::string>(d, "request_id") << " "
                                           << fb::get<std::string>(d, "kind") << " " << fb::get<std::string>(d, "body_id") << std::endl;
           return dds::to_sim_request(d);
@@ -253,9 +236,10 @@ class TwinProcess {
     auto last_tick = std::chrono::steady_clock::now();
     while (!finished && running) {
       r.wait_and_run_one(std::chrono::milliseconds(50));
-      if (std::chrono::steady_clock::now() - last_tick > std::chrono::milliseconds(250)) {
+      if (std::chrono::steady_clock::now() - last_tick > std::chrono::milliseconds(100)) {
         last_tick = std::chrono::steady_clock::now();
         r.post("orchestrator", "TICK");
+        r.post("negotiator", "TICK");
       }
     }
     if (!finished) return end_with(1, "stopped before the order ended");

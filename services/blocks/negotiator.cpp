@@ -1,0 +1,140 @@
+#include "services/blocks/negotiator.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace fb {
+
+Negotiator::Negotiator(std::string name, std::string order_id, NegotiationSettings settings,
+                       std::shared_ptr<const BidEvaluator> evaluator)
+    : FunctionBlock(std::move(name)), order_id_(std::move(order_id)), settings_(settings),
+      evaluator_(std::move(evaluator)) {
+  declare_input("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
+  declare_input("CAPABILITY", {"resource_id", "operations"});
+  declare_input("RESOURCE_GONE", {"resource_id"});
+  declare_input("PROPOSAL", {"call_id", "resource_id", "available", "reason", "earliest_start", "duration"});
+  declare_input("AWARD_REPLY", {"call_id", "resource_id", "confirmed", "reason", "ahead"});
+  declare_input("TICK");
+  declare_output("CFP", {"call_id", "order_id", "operation", "part_type", "station", "sources", "count", "duration"});
+  declare_output("AWARD", {"call_id", "resource_id", "order_id", "lease"});
+  declare_output("AWARDED", {"call_id", "resource_id", "ahead", "earliest_start", "duration"});
+  declare_output("UNAVAILABLE", {"call_id", "reason"});
+}
+
+void Negotiator::receive(const Event& e) {
+  if (e.name == "TICK") return tick();
+  if (e.name == "CAPABILITY") {
+    const auto ops = split_names(get<std::string>(e.data, "operations"));
+    operations_[get<std::string>(e.data, "resource_id")] = {ops.begin(), ops.end()};
+    return;
+  }
+  if (e.name == "RESOURCE_GONE") {
+    const std::string& resource = get<std::string>(e.data, "resource_id");
+    operations_.erase(resource);
+    for (auto& [id, c] : calls_) {
+      c.bids.erase(resource);
+      if (c.awarded == resource) refused(id, resource, resource + " disappeared");
+    }
+    return;
+  }
+  if (e.name == "CALL") {
+    Call& c = calls_[get<std::string>(e.data, "call_id")];
+    c = Call{e.data, Clock::now(), {}, {}, {}, {}, {}};
+    c.data["order_id"] = order_id_;
+    return call(c);
+  }
+  const auto it = calls_.find(get<std::string>(e.data, "call_id"));
+  if (it == calls_.end()) return;  // an answer to a call that is settled
+  Call& c = it->second;
+  const std::string& resource = get<std::string>(e.data, "resource_id");
+  if (e.name == "PROPOSAL") {
+    if (get<bool>(e.data, "available")) {
+      c.bids[resource] = {resource, get<double>(e.data, "earliest_start"), get<double>(e.data, "duration")};
+      c.refusals.erase(resource);
+    } else {
+      c.refusals[resource] = get<std::string>(e.data, "reason");
+    }
+    if (c.awarded.empty() && all_answered(c)) decide(it->first);
+  } else if (e.name == "AWARD_REPLY" && resource == c.awarded) {
+    if (!get<bool>(e.data, "confirmed")) return refused(it->first, resource, get<std::string>(e.data, "reason"));
+    const Bid bid = c.bids[resource];
+    const std::string id = it->first;
+    calls_.erase(it);
+    emit("AWARDED", {{"call_id", id}, {"resource_id", resource}, {"ahead", get<std::int64_t>(e.data, "ahead")},
+                     {"earliest_start", bid.earliest_start}, {"duration", bid.duration}});
+  }
+}
+
+void Negotiator::call(Call& c) {
+  c.called = Clock::now();
+  emit("CFP", c.data);
+}
+
+bool Negotiator::all_answered(const Call& c) const {
+  const std::string& op = get<std::string>(c.data, "operation");
+  bool any = false;
+  for (const auto& [resource, ops] : operations_) {
+    if (!ops.count(op)) continue;
+    any = true;
+    if (!c.bids.count(resource) && !c.refusals.count(resource)) return false;
+  }
+  return any;
+}
+
+void Negotiator::refused(const std::string& id, const std::string& resource, const std::string& reason) {
+  Call& c = calls_.at(id);
+  c.bids.erase(resource);
+  c.refusals[resource] = reason;
+  c.awarded.clear();
+  decide(id);
+}
+
+// The best bid is awarded; with none, the call waits for the next one or runs out.
+void Negotiator::decide(const std::string& id) {
+  Call& c = calls_.at(id);
+  const Bid* best = nullptr;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const auto& [resource, bid] : c.bids) {
+    const double cost = evaluator_->cost(bid);
+    if (cost < best_cost) best = &bid, best_cost = cost;
+  }
+  if (!best) return;
+  c.awarded = best->resource_id;
+  c.awarded_at = Clock::now();
+  emit("AWARD", {{"call_id", id}, {"resource_id", c.awarded}, {"order_id", order_id_}, {"lease", settings_.lease_s}});
+}
+
+void Negotiator::tick() {
+  const auto now = Clock::now();
+  std::vector<std::string> unavailable;
+  for (auto& [id, c] : calls_) {
+    if (!c.awarded.empty()) {
+      if (now - c.awarded_at > settings_.reply_timeout) {
+        refused(id, c.awarded, c.awarded + " did not confirm within " +
+                                   std::to_string(settings_.reply_timeout.count()) + " ms");
+      }
+      continue;
+    }
+    if (!c.bids.empty() && now - c.called >= settings_.window) {
+      decide(id);
+    } else if (c.bids.empty() && now - c.started >= settings_.wait) {
+      unavailable.push_back(id);
+    } else if (c.bids.empty() && now - c.called >= settings_.retry) {
+      call(c);
+    }
+  }
+  for (const auto& id : unavailable) {
+    const Call& c = calls_.at(id);
+    std::string reason = "nobody offered " + get<std::string>(c.data, "operation");
+    const std::string type = get_or<std::string>(c.data, "part_type", "");
+    if (!type.empty()) reason += " " + type;
+    reason += " within " + std::to_string(settings_.wait.count() / 1000) + " s";
+    std::string why;
+    for (const auto& [resource, r] : c.refusals) why += (why.empty() ? "" : "; ") + resource + ": " + r;
+    reason += why.empty() ? " (no resource with that operation answered)" : " (" + why + ")";
+    calls_.erase(id);
+    emit("UNAVAILABLE", {{"call_id", id}, {"reason", reason}});
+  }
+}
+
+}  // namespace fb

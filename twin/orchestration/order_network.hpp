@@ -1,0 +1,32 @@
+#pragma once
+// The twin's application: the OrderOrchestrator and the Negotiator (the manager's side of
+// the contract net) on one resource, wired to each other. Where their other events come
+// from and go to is the mapping's business: the twin process binds them to DDS topics, the
+// tests to a stand-in cell.
+//
+//   into "orchestrator": START, TICK, CAPABILITY, RESOURCE_GONE, COMMAND_EVENT, SIM_REPLY
+//   into "negotiator":   TICK, CAPABILITY, RESOURCE_GONE, PROPOSAL, AWARD_REPLY
+//   out of "orchestrator": RELEASE, COMMAND, CANCEL, SIM, STATUS, FINDING, FINISHED
+//   out of "negotiator":   CFP, AWARD
+
+#include <memory>
+
+#include "services/blocks/negotiator.hpp"
+#include "services/runtime/resource.hpp"
+#include "twin/orchestration/order_orchestrator.hpp"
+
+namespace twin {
+
+inline OrderOrchestrator& add_order_network(fb::Resource& resource, const LoadedProduct& product, const Plan& plan,
+                                            const OrderSettings& order, const fb::NegotiationSettings& negotiation,
+                                            std::shared_ptr<const fb::BidEvaluator> evaluator =
+                                                std::make_shared<fb::EarliestFinish>()) {
+  auto& orchestrator = resource.add(std::make_unique<OrderOrchestrator>("orchestrator", product, plan, order));
+  resource.add(std::make_unique<fb::Negotiator>("negotiator", order.order_id, negotiation, std::move(evaluator)));
+  resource.connect("orchestrator", "CALL", "negotiator", "CALL");
+  resource.connect("negotiator", "AWARDED", "orchestrator", "AWARDED");
+  resource.connect("negotiator", "UNAVAILABLE", "orchestrator", "UNAVAILABLE");
+  return orchestrator;
+}
+
+}  // namespace twin
