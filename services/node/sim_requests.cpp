@@ -26,6 +26,8 @@ Data SimRequests::spawn_fixture(const std::string& body, const Numbers& placemen
 
 Data SimRequests::remove(const std::string& body) { return request("remove", body); }
 
+Data SimRequests::ping() { return request("ping", ""); }
+
 Data SimRequests::set_static(const std::string& body, bool is_static) {
   return request(is_static ? "set_static" : "set_movable", body);
 }

@@ -19,6 +19,7 @@ class SimRequests {
   // A static body of the cell that every scene sees (a station's table).
   Data spawn_fixture(const std::string& body, const Numbers& placement, const Numbers& half_extents);
   Data remove(const std::string& body);
+  Data ping();
   Data set_static(const std::string& body, bool is_static);
   Data move(const std::string& body, const std::vector<std::string>& carried, const Numbers& path, double speed,
             double angular_speed);

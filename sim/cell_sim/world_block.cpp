@@ -66,6 +66,9 @@ void WorldBlock::handle(const fb::Data& d) {
       owner_.erase(id);
     } else if (kind == "set_static" || kind == "set_movable") {
       world_.set_static(id, kind == "set_static");
+    } else if (kind == "ping") {
+      // Answered, and nothing else: a requester learns that its requests and cell-sim's
+      // replies both reach it (DDS matches each endpoint pair on its own).
     } else if (kind == "move") {
       const MoveResult r = world_.move({id, fb::split_names(fb::get<std::string>(d, "carried")),
                                         poses(fb::get<fb::Numbers>(d, "path")), fb::get<double>(d, "speed"),

@@ -1,5 +1,6 @@
 #pragma once
-// cell-sim's function block: requests change the world at once and are answered at once;
+// cell-sim's function block: requests change the world at once and are answered at once
+// (a "ping" changes nothing and is answered too);
 // a move is answered when the sim clock reaches its end (or its first collision). TICK
 // (from the process's loop) advances the clock and publishes what is due.
 //

@@ -98,7 +98,7 @@ TEST_CASE("command life cycle: accepted, executing, succeeded", "[fb][lifecycle]
   const auto progress = f.send("PROGRESS", {{"progress", 0.5}});
   REQUIRE(names<fb::CommandLifecycle>(progress) == Names{"EXECUTING"});
   CHECK(fb::get<double>(progress[0].data, "progress") == 0.5);
-  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED"});
+  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
 }
 
@@ -110,7 +110,7 @@ TEST_CASE("command life cycle: one command at a time, and failures carry their r
   CHECK(fb::get<std::string>(busy[0].data, "command_id") == "c2");
   CHECK(fb::get<std::string>(busy[0].data, "reason") == "busy with c1");
   const auto aborted = f.send("FAIL", {{"reason", std::string("collision with B6")}});
-  REQUIRE(names<fb::CommandLifecycle>(aborted) == Names{"ABORTED"});
+  REQUIRE(names<fb::CommandLifecycle>(aborted) == Names{"ABORTED", "IDLE"});
   CHECK(fb::get<std::string>(aborted[0].data, "reason") == "collision with B6");
   CHECK(names<fb::CommandLifecycle>(f.send("COMMAND", {{"command_id", std::string("c2")}})) ==
         Names{"ACCEPTED", "START"});
@@ -122,11 +122,11 @@ TEST_CASE("command life cycle: cancel, and a device that finishes before it can 
   CHECK(f.send("CANCEL", {{"command_id", std::string("other")}}).empty());  // not ours: ignored
   CHECK(names<fb::CommandLifecycle>(f.send("CANCEL", {{"command_id", std::string("c1")}})) ==
         Names{"CANCELING", "STOP"});
-  CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED"});
+  CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
 
   f.send("COMMAND", {{"command_id", std::string("c2")}});
   f.send("CANCEL", {{"command_id", std::string("c2")}});
-  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED"});
+  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
 }
 
@@ -157,59 +157,8 @@ TEST_CASE("command life cycle with a queue: one executes, the rest wait their tu
   const auto failed = f.send("FAIL", {{"reason", std::string("buffer-1 has no Peg")}});
   REQUIRE(names<fb::CommandLifecycle>(failed) == Names{"ABORTED", "START"});
   CHECK(fb::get<std::string>(failed[1].data, "command_id") == "c3");
-  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED"});
+  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
-}
-
-namespace {
-fb::Data cfp(const std::string& order, const std::string& operation) {
-  return {{"call_id", order + "/" + operation}, {"order_id", order}, {"operation", operation},
-          {"part_type", std::string()}};
-}
-fb::Data award(const std::string& order, const std::string& operation) {
-  return {{"call_id", order + "/" + operation}, {"resource_id", std::string("arm-1")}, {"order_id", order}};
-}
-fb::Contractor::CanServe moves_only() {
-  return [](const std::string& operation, const std::string&) { return operation == "translate"; };
-}
-}  // namespace
-
-TEST_CASE("contractor: proposes what it can serve, and is reserved by the order it confirms", "[fb][negotiation]") {
-  fb::BlockTestFixture<fb::Contractor> f("contractor", "arm-1", true, moves_only(), 2.0);
-  CHECK(f.send("CFP", cfp("o1", "fetch")).empty());
-  const auto proposal = f.send("CFP", cfp("o1", "translate"));
-  REQUIRE(names<fb::Contractor>(proposal) == Names{"PROPOSE"});
-  CHECK(fb::get<double>(proposal[0].data, "duration") == 2.0);
-  const auto confirmed = f.send("AWARD", award("o1", "translate"));
-  REQUIRE(names<fb::Contractor>(confirmed) == Names{"REPLY", "RESERVED"});
-  CHECK(fb::get<bool>(confirmed[0].data, "confirmed"));
-  CHECK(f.block().reserved_by() == "o1");
-
-  CHECK(f.send("CFP", cfp("o2", "translate")).empty());  // reserved: another order hears nothing
-  const auto refused = f.send("AWARD", award("o2", "translate"));
-  REQUIRE(names<fb::Contractor>(refused) == Names{"REPLY"});
-  CHECK_FALSE(fb::get<bool>(refused[0].data, "confirmed"));
-  CHECK(fb::get<std::string>(refused[0].data, "reason") == "arm-1 is reserved by order o1");
-
-  CHECK(f.send("ORDER_ENDED", {{"order_id", std::string("o2")}}).empty());
-  const auto freed = f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
-  REQUIRE(names<fb::Contractor>(freed) == Names{"RESERVED"});
-  CHECK(fb::get<std::string>(freed[0].data, "order_id").empty());
-  CHECK(names<fb::Contractor>(f.send("CFP", cfp("o2", "translate"))) == Names{"PROPOSE"});
-}
-
-TEST_CASE("contractor: a shared resource confirms every order, and a release frees the holder", "[fb][negotiation]") {
-  fb::BlockTestFixture<fb::Contractor> shared("contractor", "arm-1", false, moves_only());
-  CHECK(fb::get<bool>(shared.send("AWARD", award("o1", "translate"))[0].data, "confirmed"));
-  CHECK(fb::get<bool>(shared.send("AWARD", award("o2", "translate"))[0].data, "confirmed"));
-  CHECK(shared.block().reserved_by().empty());
-
-  fb::BlockTestFixture<fb::Contractor> exclusive("contractor", "arm-1", true, moves_only());
-  exclusive.send("AWARD", award("o1", "translate"));
-  CHECK(exclusive.send("RELEASE", {{"order_id", std::string("o2")}, {"resource_id", std::string("arm-1")}}).empty());
-  CHECK(names<fb::Contractor>(exclusive.send(
-            "RELEASE", {{"order_id", std::string("o1")}, {"resource_id", std::string("arm-1")}})) == Names{"RESERVED"});
-  CHECK(exclusive.block().reserved_by().empty());
 }
 
 TEST_CASE("command life cycle with a queue: a queued command is canceled at once", "[fb][lifecycle]") {

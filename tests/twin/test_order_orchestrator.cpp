@@ -1,61 +1,138 @@
-// The twin's orchestration block driven with events and no DDS: a stand-in cell answers every
-// cell-sim request and command, and refuses what the test says.
+// The twin's application (OrderOrchestrator and Negotiator) driven with events and no DDS: a
+// stand-in cell bids for every call, answers every cell-sim request and command, and refuses
+// what the test says.
 
 #include <functional>
 
 #include <catch2/catch.hpp>
 
-#include "services/runtime/block_test_fixture.hpp"
 #include "twin/geometry/product_loader.hpp"
-#include "twin/orchestration/order_orchestrator.hpp"
+#include "twin/orchestration/order_network.hpp"
 
 namespace {
 
 using fb::Data;
 using fb::get;
 
+// Takes every event the twin's blocks send out.
+class Outbox : public fb::FunctionBlock {
+ public:
+  Outbox() : FunctionBlock("outbox") {
+    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "FINISHED", "CFP", "AWARD"}) {
+      declare_input(e);
+    }
+  }
+  void receive(const fb::Event& event) override { events.push_back(event); }
+  std::vector<fb::Event> events;
+};
+
+struct Twin {
+  Twin(const twin::LoadedProduct& product, const twin::Plan& plan) : resource("twin", 4096) {
+    twin::OrderSettings order;
+    order.order_id = "o1";
+    orchestrator = &twin::add_order_network(resource, product, plan, order, fb::NegotiationSettings{});
+    outbox = &resource.add(std::make_unique<Outbox>());
+    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "FINISHED"}) {
+      resource.connect("orchestrator", e, "outbox", e);
+    }
+    for (const char* e : {"CFP", "AWARD"}) resource.connect("negotiator", e, "outbox", e);
+  }
+  std::vector<fb::Event> send(const std::string& block, const std::string& input, Data data = {}) {
+    outbox->events.clear();
+    resource.post(block, input, std::move(data));
+    resource.run_until_idle();
+    return outbox->events;
+  }
+  fb::Resource resource;
+  twin::OrderOrchestrator* orchestrator = nullptr;
+  Outbox* outbox = nullptr;
+};
+
 struct Outcome {
   std::vector<std::string> findings;  // kinds
   std::vector<std::string> canceled;  // command ids
   std::vector<std::string> spawned;   // bodies, in order
+  std::vector<std::string> statuses;  // messages
+  std::vector<std::string> order;     // what went out: "SIM spawn", "CFP host", ...
   bool finished = false, complete = false;
   std::string error;
 };
 
-// Runs an order against a cell that answers everything at once; `refuse(command)` returns a
-// reason to abort a command with (empty: it succeeds; kNoAnswer: it is never answered).
+// The stand-in cell's answers. `collide(move, parts placed so far)`: a cell-sim move that collides;
+// `refuse(command)`: a reason to abort a command with (empty: it succeeds; kNoAnswer: it is
+// never answered); `ahead`: the station's queue before this order.
 const std::string kNoAnswer = "(no answer)";
-Outcome run(fb::BlockTestFixture<twin::OrderOrchestrator>& f, const std::function<std::string(const Data&)>& refuse) {
+struct Cell {
+  std::function<bool(const Data&, long)> collide = [](const Data&, long) { return false; };
+  std::function<std::string(const Data&)> refuse = [](const Data&) { return std::string(); };
+  long ahead = 0;
+};
+
+Outcome run(Twin& t, const Cell& cell) {
   Outcome out;
-  for (const char* id : {"station-1", "arm-1", "mobile-robot-1", "buffer-1"}) {
-    f.send("CAPABILITY", {{"resource_id", std::string(id)}, {"dock", fb::Numbers{0.6, 0, 0}},
-                          {"position", fb::Numbers{0, 0, 0}}});
-  }
-  std::vector<fb::Event> pending = f.send("START");
-  for (int guard = 0; !pending.empty() && guard < 100000; ++guard) {
+  const auto capability = [&](const std::string& id, const std::string& kind, const std::string& ops,
+                              const std::string& holder) {
+    const Data c{{"resource_id", id},         {"kind", kind},           {"operations", ops},
+                 {"position", fb::Numbers{0, 0, 0}}, {"dock", fb::Numbers{0.6, 0, 0}}, {"speed", 0.25},
+                 {"angular_speed", 1.0},       {"reserved_by", holder},  {"waiting", std::string()}};
+    std::vector<fb::Event> out = t.send("negotiator", "CAPABILITY", c);
+    const auto more = t.send("orchestrator", "CAPABILITY", c);
+    out.insert(out.end(), more.begin(), more.end());
+    return out;
+  };
+  capability("station-1", "station", "host", "");
+  capability("arm-1", "arm", "grip,translate", "");
+  capability("mobile-robot-1", "mobile-robot", "fetch", "");
+  capability("buffer-1", "buffer", "give", "");
+  std::vector<fb::Event> pending = t.send("orchestrator", "START");
+  bool queued_reported = false;
+  for (int guard = 0; guard < 100000; ++guard) {
+    if (pending.empty()) {
+      // The station's queue moves on once the order has said it waits.
+      if (cell.ahead == 0 || !queued_reported || out.finished) break;
+      queued_reported = false;
+      pending = capability("station-1", "station", "host", "o1");
+      continue;
+    }
     const fb::Event e = pending.front();
     pending.erase(pending.begin());
     std::vector<fb::Event> more;
     if (e.name == "CFP") {
       const std::string& op = get<std::string>(e.data, "operation");
+      out.order.push_back("CFP " + op);
       const std::string resource = op == "host" ? "station-1" : op == "translate" ? "arm-1"
                                  : op == "fetch" ? "mobile-robot-1" : "buffer-1";
-      more = f.send("PROPOSAL", {{"call_id", e.data.at("call_id")}, {"resource_id", resource}});
+      more = t.send("negotiator", "PROPOSAL", {{"call_id", e.data.at("call_id")}, {"resource_id", resource},
+                                               {"available", true}, {"reason", std::string()},
+                                               {"earliest_start", 0.0}, {"duration", 1.0}});
     } else if (e.name == "AWARD") {
-      more = f.send("AWARD_REPLY", {{"call_id", e.data.at("call_id")}, {"resource_id", e.data.at("resource_id")},
-                                    {"confirmed", true}, {"reason", std::string()}});
+      const bool host = get<std::string>(e.data, "resource_id") == "station-1";
+      more = t.send("negotiator", "AWARD_REPLY", {{"call_id", e.data.at("call_id")},
+                                                  {"resource_id", e.data.at("resource_id")}, {"confirmed", true},
+                                                  {"reason", std::string()},
+                                                  {"ahead", std::int64_t(host ? cell.ahead : 0)}});
     } else if (e.name == "SIM") {
-      if (get<std::string>(e.data, "kind") == "spawn") out.spawned.push_back(get<std::string>(e.data, "body_id"));
-      more = f.send("SIM_REPLY", {{"request_id", e.data.at("request_id")}, {"ok", true}, {"error", std::string()},
-                                  {"collided", false}});
+      const std::string& kind = get<std::string>(e.data, "kind");
+      out.order.push_back("SIM " + kind);
+      if (kind == "spawn") out.spawned.push_back(get<std::string>(e.data, "body_id"));
+      const bool collided = kind == "move" && cell.collide(e.data, std::count(out.order.begin(), out.order.end(), "SIM set_static"));
+      more = t.send("orchestrator", "SIM_REPLY",
+                    {{"request_id", e.data.at("request_id")}, {"ok", true}, {"error", std::string()},
+                     {"collided", collided}, {"hit_body", std::string("B1")}, {"hit_member", std::string("it")},
+                     {"depth", 0.001}, {"start_time", 0.0}, {"end_time", 1.0}, {"distance", 0.1}});
     } else if (e.name == "COMMAND") {
-      const std::string reason = refuse(e.data);
+      out.order.push_back("COMMAND " + get<std::string>(e.data, "operation"));
+      const std::string reason = cell.refuse(e.data);
       if (reason == kNoAnswer) continue;
-      more = f.send("COMMAND_EVENT", {{"command_id", e.data.at("command_id")}, {"order_id", e.data.at("order_id")},
-                                      {"state", std::string(reason.empty() ? "succeeded" : "aborted")},
-                                      {"reason", reason}});
+      more = t.send("orchestrator", "COMMAND_EVENT", {{"command_id", e.data.at("command_id")},
+                                                      {"order_id", e.data.at("order_id")},
+                                                      {"state", std::string(reason.empty() ? "succeeded" : "aborted")},
+                                                      {"reason", reason}});
     } else if (e.name == "CANCEL") {
       out.canceled.push_back(get<std::string>(e.data, "command_id"));
+    } else if (e.name == "STATUS") {
+      out.statuses.push_back(get<std::string>(e.data, "message"));
+      queued_reported |= out.statuses.back().find("orders ahead") != std::string::npos;
     } else if (e.name == "FINDING") {
       out.findings.push_back(get<std::string>(e.data, "kind"));
     } else if (e.name == "FINISHED") {
@@ -71,39 +148,63 @@ Outcome run(fb::BlockTestFixture<twin::OrderOrchestrator>& f, const std::functio
 // A product from deploy/products, planned (search, linear) as the twin plans it.
 struct Planned {
   explicit Planned(const std::string& product_file)
-      : product(twin::load_product(std::string(PRODUCTS_DIR) + "/" + product_file, meshes)),
-        plan(plan_of(product)) {}
+      : product(twin::load_product(std::string(PRODUCTS_DIR) + "/" + product_file, meshes)), plan(plan_of(product)) {}
   static twin::Plan plan_of(const twin::LoadedProduct& product) {
     twin::SearchSequencePlanner sequence;
     return twin::plan_assembly(product, sequence, *twin::make_path_planner("linear"));
-  }
-  static twin::OrderSettings order_o1() {
-    twin::OrderSettings settings;
-    settings.order_id = "o1";
-    return settings;
   }
   sim::MeshCache meshes;
   twin::LoadedProduct product;
   twin::Plan plan;
 };
 
+bool carries(const Data& move, const std::string& body) {
+  const auto carried = fb::split_names(get<std::string>(move, "carried"));
+  return std::find(carried.begin(), carried.end(), body) != carried.end();
+}
+
 }  // namespace
+
+TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holding nothing; then a station",
+          "[twin][orchestration]") {
+  const Planned cranfield("cranfield/cranfield.aml");
+  Twin t(cranfield.product, cranfield.plan);
+  const Outcome out = run(t, Cell{});
+  INFO(out.error);
+  CHECK(out.complete);
+  // Nothing is called for before every virtual part stands; the station comes first.
+  const auto first_call = std::find_if(out.order.begin(), out.order.end(), [](const std::string& s) { return s.rfind("CFP", 0) == 0; });
+  REQUIRE(first_call != out.order.end());
+  CHECK(*first_call == "CFP host");
+  const long static_parts = std::count(out.order.begin(), first_call, "SIM set_static");
+  CHECK(static_parts == static_cast<long>(cranfield.plan.steps.size()));
+  CHECK(std::find(out.order.begin(), first_call, "COMMAND grip") == first_call);  // no arm in virtual assembly
+  // The hired robot gets one fetch per part, the arm one grip per part.
+  CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND fetch") == static_cast<long>(cranfield.plan.steps.size()));
+  CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND grip") == static_cast<long>(cranfield.plan.steps.size()));
+}
+
+TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on when the station is its", "[twin][orchestration]") {
+  const Planned lego("lego-tower/lego-tower.aml");
+  Twin t(lego.product, lego.plan);
+  Cell cell;
+  cell.ahead = 3;
+  const Outcome out = run(t, cell);
+  INFO(out.error);
+  CHECK(out.complete);
+  CHECK(std::find(out.statuses.begin(), out.statuses.end(), "waiting for station-1: 3 orders ahead") != out.statuses.end());
+}
 
 TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequence planning", "[twin][orchestration]") {
   const Planned cranfield("cranfield/cranfield.aml");
   const twin::Plan& plan = cranfield.plan;
   REQUIRE(plan.complete);
   const std::string second = "o1/virtual/" + cranfield.product.product.parts()[plan.steps[1].part].name;
-  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", cranfield.product, plan, Planned::order_o1());
-
-  // cell-sim refuses every move of the plan's second part while it would be second.
-  int connected = 0;
-  const Outcome out = run(f, [&](const Data& c) -> std::string {
-    const std::string& op = get<std::string>(c, "operation");
-    if (op == "connect" && get<std::string>(c, "part").find("/virtual/") != std::string::npos) ++connected;
-    if (op == "translate" && get<std::string>(c, "part") == second && connected == 1) return "collision of it";
-    return "";
-  });
+  Twin t(cranfield.product, plan);
+  // cell-sim stops every move of the plan's second part while it would be second.
+  Cell cell;
+  cell.collide = [&](const Data& move, long placed) { return carries(move, second) && placed == 1; };
+  const Outcome out = run(t, cell);
   INFO(out.error);
   CHECK(out.finished);
   CHECK(out.complete);
@@ -112,7 +213,7 @@ TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequenc
         static_cast<long>(plan.steps[1].failed.size() + 1));
   CHECK(std::count(out.findings.begin(), out.findings.end(), "backtrack") == 1);
   // The part came later instead; the rest of the plan is complete and validated.
-  const auto& steps = f.block().plan().steps;
+  const auto& steps = t.orchestrator->plan().steps;
   REQUIRE(steps.size() == plan.steps.size());
   CHECK(steps[0].part == plan.steps[0].part);
   CHECK(steps[1].part != plan.steps[1].part);
@@ -121,39 +222,38 @@ TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequenc
 
 TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, with the reason", "[twin][orchestration]") {
   const Planned lego("lego-tower/lego-tower.aml");
-  const twin::Plan& plan = lego.plan;
-  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", lego.product, plan, Planned::order_o1());
-  const Outcome out = run(f, [](const Data& c) -> std::string {
-    return get<std::string>(c, "operation") == "translate" && get<std::string>(c, "part") == "o1/virtual/hanging"
-               ? "collision of it" : "";
-  });
+  Twin t(lego.product, lego.plan);
+  Cell cell;
+  cell.collide = [](const Data& move, long) { return carries(move, "o1/virtual/hanging"); };
+  const Outcome out = run(t, cell);
   CHECK(out.finished);
   CHECK_FALSE(out.complete);
   CHECK(out.error.find("no collision-free path in cell-sim for hanging") != std::string::npos);
-  // What it had spawned left cell-sim again.
-  CHECK(f.block().state() == "ENDED");
+  CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") == out.order.end());  // never booked a station
+  CHECK(t.orchestrator->state() == "ENDED");
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {
   const Planned lego("lego-tower/lego-tower.aml");
-  const twin::Plan& plan = lego.plan;
-  fb::BlockTestFixture<twin::OrderOrchestrator> f("twin", lego.product, plan, Planned::order_o1());
+  Twin t(lego.product, lego.plan);
   // The robot delivers the first two parts; the arm cannot grip the second.
-  int fetches = 0, physical_grips = 0;
+  int fetches = 0, grips = 0;
   std::vector<std::string> unanswered;
-  const Outcome out = run(f, [&](const Data& c) -> std::string {
+  Cell cell;
+  cell.refuse = [&](const Data& c) -> std::string {
     const std::string& op = get<std::string>(c, "operation");
     if (op == "fetch" && ++fetches > 2) {
       unanswered.push_back(get<std::string>(c, "command_id"));
       return kNoAnswer;
     }
-    const bool physical = get<std::string>(c, "part").find("/virtual/") == std::string::npos;
-    if (op == "grip" && physical && ++physical_grips == 2) return "gripper jammed";
+    if (op == "grip" && ++grips == 2) return "gripper jammed";
     return "";
-  });
+  };
+  const Outcome out = run(t, cell);
   CHECK(out.finished);
   CHECK_FALSE(out.complete);
   CHECK(out.error.find("gripper jammed") != std::string::npos);
-  CHECK(out.canceled == unanswered);
-  CHECK(unanswered.size() == plan.steps.size() - 2);
+  std::sort(unanswered.begin(), unanswered.end());
+  CHECK(out.canceled == unanswered);  // both in the order of their ids
+  CHECK(unanswered.size() == lego.plan.steps.size() - 2);
 }

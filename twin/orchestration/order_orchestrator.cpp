@@ -62,16 +62,22 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     });
   }
 
+  // cell-sim is pinged until it answers: then requests and replies both get through.
   transition("IDLE", "START", "WAITING_CELL", [this](const Data&) {
     waiting_since_ = std::chrono::steady_clock::now();
     status("PLANNING", "planned " + std::to_string(plan_.steps.size()) + " steps; waiting for a station of the cell", 0);
+    emit("SIM", sim_.ping());
+  });
+  transition("WAITING_CELL", "SIM_REPLY", "WAITING_CELL", [this](const Data&) {
+    sim_answers_ = true;
     try_begin_virtual();
   });
   transition("WAITING_CELL", "TICK", "WAITING_CELL", [this](const Data&) {
     if (waited_too_long()) {
-      fail("no station of the cell appeared within " + std::to_string(settings_.wait_timeout.count() / 1000) +
-           " s: is the cell up?");
+      return fail(std::string(sim_answers_ ? "no station of the cell appeared" : "cell-sim did not answer") +
+                  " within " + std::to_string(settings_.wait_timeout.count() / 1000) + " s: is the cell up?");
     }
+    if (!sim_answers_) emit("SIM", sim_.ping());
   });
 
   // Cell-sim's answers, in the states that send it requests.
@@ -154,7 +160,7 @@ void OrderOrchestrator::try_begin_virtual() {
     }
     if (p.kind == "station" && virtual_station_.empty()) virtual_station_ = id;
   }
-  if (virtual_station_.empty()) return;
+  if (virtual_station_.empty() || !sim_answers_) return;
   enter("VIRTUAL");
   status("VIRTUAL_ASSEMBLY", "virtual assembly in cell-sim", 0);
   step_ = candidate_ = 0;

@@ -2,7 +2,8 @@
 // One order's orchestration (the paper's Fig. 5 after planning), as an IEC 61499 basic block
 // driven by events, never waiting on a call. Its execution control chart:
 //
-//   IDLE -START-> WAITING_CELL   until a station of the cell is known (bounded by `wait`)
+//   IDLE -START-> WAITING_CELL   until cell-sim answers a ping and a station of the cell is
+//                known (bounded by `wait`)
 //   VIRTUAL      virtual assembly in cell-sim, in the order's own virtual scene (it meets
 //                the cell's fixtures and nothing of other orders, so many orders do this at
 //                once and hold no resource): each part spawned where its trajectory starts,
@@ -131,6 +132,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::size_t step_ = 0, candidate_ = 0;
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
   std::string virtual_station_;
+  bool sim_answers_ = false;
   // Physical assembly: what was awarded.
   std::string station_, arm_, robot_;
   std::map<std::string, std::string> buffer_of_;  // part type -> buffer

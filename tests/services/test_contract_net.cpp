@@ -1,0 +1,190 @@
+// The contract net's two sides as blocks, driven with events and no DDS: the Contractor
+// (a resource's bids, its queue of orders, its work taken on) and the Negotiator (a twin's
+// calls, the choice of the best bid, refusals, a queue place, a call nobody answers).
+
+#include <thread>
+
+#include <catch2/catch.hpp>
+
+#include "services/blocks/contractor.hpp"
+#include "services/blocks/negotiator.hpp"
+#include "services/runtime/block_test_fixture.hpp"
+
+namespace {
+
+using Names = std::vector<std::string>;
+template <class B>
+Names names(const std::vector<fb::Event>& events) {
+  return fb::BlockTestFixture<B>::names(events);
+}
+
+fb::Data cfp(const std::string& order, const std::string& operation, double duration = 10) {
+  return {{"call_id", order + "/" + operation}, {"order_id", order},   {"operation", operation},
+          {"part_type", std::string()},         {"station", std::string("station-1")},
+          {"sources", std::string()},           {"count", std::int64_t(0)}, {"duration", duration}};
+}
+fb::Data award(const std::string& order, const std::string& operation, const std::string& resource = "station-1") {
+  return {{"call_id", order + "/" + operation}, {"resource_id", resource}, {"order_id", order}};
+}
+// Holds for the call's duration; sim time is `now`.
+double now = 100;
+fb::Contractor::EstimateFn holds() {
+  return [](const fb::Data& call) { return fb::Contractor::Estimate{true, "", fb::get<double>(call, "duration")}; };
+}
+
+}  // namespace
+
+TEST_CASE("contractor: bids only for what it offers, after the orders it holds and queues", "[fb][negotiation]") {
+  now = 100;
+  fb::BlockTestFixture<fb::Contractor> f("contractor", "station-1", std::set<std::string>{"host"}, true, holds(),
+                                         [] { return now; });
+  CHECK(f.send("CFP", cfp("o1", "fetch")).empty());  // not an operation it offers
+  const auto bid = f.send("CFP", cfp("o1", "host", 30));
+  REQUIRE(names<fb::Contractor>(bid) == Names{"PROPOSE"});
+  CHECK(fb::get<bool>(bid[0].data, "available"));
+  CHECK(fb::get<double>(bid[0].data, "earliest_start") == 100);
+  CHECK(fb::get<double>(bid[0].data, "duration") == 30);
+  const auto held = f.send("AWARD", award("o1", "host"));
+  REQUIRE(names<fb::Contractor>(held) == Names{"REPLY", "RESERVED", "AWARDED"});
+  CHECK(fb::get<bool>(held[0].data, "confirmed"));
+  CHECK(fb::get<std::int64_t>(held[0].data, "ahead") == 0);
+  CHECK(f.block().reserved_by() == "o1");
+
+  // Held: o2 is offered the time after o1's expected end, and a place in the queue; o3 after both.
+  now = 110;
+  CHECK(fb::get<double>(f.send("CFP", cfp("o2", "host", 20))[0].data, "earliest_start") == 130);
+  const auto queued = f.send("AWARD", award("o2", "host"));
+  CHECK(fb::get<bool>(queued[0].data, "confirmed"));
+  CHECK(fb::get<std::int64_t>(queued[0].data, "ahead") == 1);
+  CHECK(fb::get<double>(f.send("CFP", cfp("o3", "host", 5))[0].data, "earliest_start") == 150);
+  CHECK(fb::get<std::int64_t>(f.send("AWARD", award("o3", "host"))[0].data, "ahead") == 2);
+  CHECK(f.block().waiting() == Names{"o2", "o3"});
+
+  // o2 gives up waiting (its twin ended); o1 releases: o3 holds it.
+  REQUIRE(names<fb::Contractor>(f.send("ORDER_ENDED", {{"order_id", std::string("o2")}})) == Names{"RESERVED"});
+  const auto next = f.send("RELEASE", {{"order_id", std::string("o1")}, {"resource_id", std::string("station-1")}});
+  REQUIRE(names<fb::Contractor>(next) == Names{"RESERVED"});
+  CHECK(fb::get<std::string>(next[0].data, "order_id") == "o3");
+  CHECK(f.block().waiting().empty());
+  // An award it never offered for is refused with the reason.
+  const auto unknown = f.send("AWARD", award("o9", "host"));
+  CHECK_FALSE(fb::get<bool>(unknown[0].data, "confirmed"));
+  CHECK(fb::get<std::string>(unknown[0].data, "reason").find("made no offer") != std::string::npos);
+}
+
+TEST_CASE("contractor: a shared resource takes work into its queue and bids after it", "[fb][negotiation]") {
+  now = 10;
+  fb::BlockTestFixture<fb::Contractor> f("contractor", "robot-1", std::set<std::string>{"fetch"}, false, holds(),
+                                         [] { return now; });
+  f.send("CFP", cfp("o1", "fetch", 8));
+  const auto taken = f.send("AWARD", award("o1", "fetch", "robot-1"));
+  REQUIRE(names<fb::Contractor>(taken) == Names{"REPLY", "AWARDED"});
+  CHECK(fb::get<std::string>(taken[1].data, "order_id") == "o1");
+  CHECK(f.block().reserved_by().empty());
+  CHECK(f.block().serves("o1"));
+  CHECK(fb::get<double>(f.send("CFP", cfp("o2", "fetch", 4))[0].data, "earliest_start") == 18);
+  f.send("AWARD", award("o2", "fetch", "robot-1"));
+  CHECK(fb::get<double>(f.send("CFP", cfp("o3", "fetch", 4))[0].data, "earliest_start") == 22);
+  now = 15;
+  f.send("IDLE");  // the work ran out early: the estimate starts again from now
+  CHECK(fb::get<double>(f.send("CFP", cfp("o3", "fetch", 4))[0].data, "earliest_start") == 15);
+  f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
+  CHECK_FALSE(f.block().serves("o1"));
+}
+
+TEST_CASE("contractor: a refusal says why", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Contractor> f(
+      "contractor", "buffer-1", std::set<std::string>{"give"}, false,
+      [](const fb::Data&) { return fb::Contractor::Estimate{false, "buffer-1 has 0 Shaft free, not 1", 0}; },
+      [] { return 0.0; });
+  const auto refusal = f.send("CFP", cfp("o1", "give"));
+  CHECK_FALSE(fb::get<bool>(refusal[0].data, "available"));
+  CHECK(fb::get<std::string>(refusal[0].data, "reason") == "buffer-1 has 0 Shaft free, not 1");
+}
+
+namespace {
+
+fb::Data capability(const std::string& id, const std::string& operations) {
+  return {{"resource_id", id}, {"operations", operations}};
+}
+fb::Data proposal(const std::string& call, const std::string& resource, double start, double duration) {
+  return {{"call_id", call},         {"resource_id", resource}, {"available", true},
+          {"reason", std::string()}, {"earliest_start", start}, {"duration", duration}};
+}
+fb::Data reply(const std::string& call, const std::string& resource, bool confirmed, long ahead = 0) {
+  return {{"call_id", call},         {"resource_id", resource}, {"confirmed", confirmed},
+          {"reason", std::string(confirmed ? "" : "busy")}, {"ahead", std::int64_t(ahead)}};
+}
+fb::NegotiationSettings quick() {
+  fb::NegotiationSettings s;
+  s.window = std::chrono::milliseconds(0);
+  s.retry = std::chrono::milliseconds(0);
+  s.wait = std::chrono::milliseconds(50);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("negotiator: once every capable resource answered, the earliest finish wins", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", fb::NegotiationSettings{});
+  f.send("CAPABILITY", capability("robot-1", "fetch"));
+  f.send("CAPABILITY", capability("robot-2", "fetch"));
+  f.send("CAPABILITY", capability("buffer-1", "give"));
+  const auto out = f.send("CALL", cfp("o1", "fetch"));
+  REQUIRE(names<fb::Negotiator>(out) == Names{"CFP"});
+  CHECK(fb::get<std::string>(out[0].data, "order_id") == "o1");
+  // robot-1 starts sooner but finishes later.
+  CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 10, 30)).empty());
+  const auto award = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 20, 5));
+  REQUIRE(names<fb::Negotiator>(award) == Names{"AWARD"});
+  CHECK(fb::get<std::string>(award[0].data, "resource_id") == "robot-2");
+  // robot-2 refuses: the next best is awarded; it confirms.
+  const auto next = f.send("AWARD_REPLY", reply("o1/fetch", "robot-2", false));
+  REQUIRE(names<fb::Negotiator>(next) == Names{"AWARD"});
+  CHECK(fb::get<std::string>(next[0].data, "resource_id") == "robot-1");
+  const auto done = f.send("AWARD_REPLY", reply("o1/fetch", "robot-1", true, 2));
+  REQUIRE(names<fb::Negotiator>(done) == Names{"AWARDED"});
+  CHECK(fb::get<std::string>(done[0].data, "resource_id") == "robot-1");
+  CHECK(fb::get<std::int64_t>(done[0].data, "ahead") == 2);
+  CHECK(f.block().open_calls() == 0);
+}
+
+TEST_CASE("negotiator: a bid evaluator of the cell's own decides", "[fb][negotiation]") {
+  struct ShortestWork : fb::BidEvaluator {
+    double cost(const fb::Bid& bid) const override { return bid.duration; }
+  };
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", fb::NegotiationSettings{}, std::make_shared<ShortestWork>());
+  f.send("CAPABILITY", capability("robot-1", "fetch"));
+  f.send("CAPABILITY", capability("robot-2", "fetch"));
+  f.send("CALL", cfp("o1", "fetch"));
+  f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9));
+  const auto award = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 50, 3));
+  CHECK(fb::get<std::string>(award[0].data, "resource_id") == "robot-2");
+}
+
+TEST_CASE("negotiator: a call nobody bids on is called again, then unavailable with every reason", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", quick());
+  f.send("CAPABILITY", capability("buffer-1", "give"));
+  f.send("CALL", cfp("o1", "give"));
+  CHECK(f.send("PROPOSAL", {{"call_id", std::string("o1/give")}, {"resource_id", std::string("buffer-1")},
+                            {"available", false}, {"reason", std::string("buffer-1 has 0 Shaft free, not 1")},
+                            {"earliest_start", 0.0}, {"duration", 0.0}}).empty());
+  CHECK(names<fb::Negotiator>(f.send("TICK")) == Names{"CFP"});  // called again
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  const auto out = f.send("TICK");
+  REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
+  CHECK(fb::get<std::string>(out[0].data, "reason").find("buffer-1: buffer-1 has 0 Shaft free, not 1") != std::string::npos);
+}
+
+TEST_CASE("negotiator: the awarded resource disappears before it confirms: the next bid wins", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", fb::NegotiationSettings{});
+  f.send("CAPABILITY", capability("station-1", "host"));
+  f.send("CAPABILITY", capability("station-2", "host"));
+  f.send("CALL", cfp("o1", "host"));
+  f.send("PROPOSAL", proposal("o1/host", "station-1", 0, 10));
+  const auto award = f.send("PROPOSAL", proposal("o1/host", "station-2", 5, 10));
+  CHECK(fb::get<std::string>(award[0].data, "resource_id") == "station-1");
+  const auto next = f.send("RESOURCE_GONE", {{"resource_id", std::string("station-1")}});
+  REQUIRE(names<fb::Negotiator>(next) == Names{"AWARD"});
+  CHECK(fb::get<std::string>(next[0].data, "resource_id") == "station-2");
+}
