@@ -17,7 +17,8 @@ BufferBlock::BufferBlock(std::string name, std::string resource_id, std::map<std
     const std::string order = get_or<std::string>(d, "order_id", "");
     int& kept = kept_[order][type];
     if (kept == 0 && free(type) == 0) {
-      return emit("FAIL", {{"reason", "buffer " + this->resource_id() + " has no " + type + " for order " + order}});
+      return emit("FAIL", {{"reason", "buffer " + this->resource_id() + " has no " + type +
+                                           (order.empty() ? "" : " free for order " + order)}});
     }
     if (kept > 0) --kept;
     --stock_[type];

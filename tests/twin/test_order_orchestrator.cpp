@@ -165,7 +165,7 @@ bool carries(const Data& move, const std::string& body) {
 
 }  // namespace
 
-TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holding nothing; then a station",
+TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holding nothing, then a station",
           "[twin][orchestration]") {
   const Planned cranfield("cranfield/cranfield.aml");
   Twin t(cranfield.product, cranfield.plan);
