@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, then builds and runs the whole test suite twice: a Release
-# build, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer.
+# build, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer; then the
+# block, DDS and process tests (labels blocks, dds, processes) once more under
+# ThreadSanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh
@@ -17,3 +19,9 @@ cmake --build build/sanitize -j "$jobs"
 fastdds shm clean >/dev/null 2>&1 || true
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs"
+
+cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_TSAN=ON -DCELL_BUILD_BENCHMARKS=OFF
+cmake --build build/tsan -j "$jobs"
+fastdds shm clean >/dev/null 2>&1 || true
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
+  ctest --test-dir build/tsan --output-on-failure -j "$jobs" -L "blocks|dds|processes"

@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <sys/resource.h>
 
+#include <atomic>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -22,8 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-volatile std::sig_atomic_t stop_requested = 0;
-void request_stop(int) { stop_requested = 1; }
+std::atomic<bool> stop_requested{false};  // set by a signal handler
+void request_stop(int) { stop_requested = true; }
 
 struct CellOptions {
   std::string cell = CELL_DEFAULT_FILE;

@@ -2,6 +2,7 @@
 // "give" command, publishes its capability (with its stock) until it is stopped.
 //   buffer --id buffer-1 --domain 42 --stock SquarePeg=2 --stock RoundPeg=4
 
+#include <atomic>
 #include <csignal>
 #include <iostream>
 
@@ -11,8 +12,9 @@
 #include "services/dds/cli_options.hpp"
 
 namespace {
-volatile std::sig_atomic_t running = 1;
-void stop(int) { running = 0; }
+// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
+std::atomic<bool> running{true};
+void stop(int) { running = false; }
 }  // namespace
 
 int main(int argc, char** argv) {

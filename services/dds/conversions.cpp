@@ -57,6 +57,28 @@ const char* state_name(cell::CommandState state) {
   return "unknown";
 }
 
+cell::CommandEvent to_command_event(const fb::Data& d) {
+  const auto text = [&](const char* key) { return fb::get_or<std::string>(d, key, ""); };
+  cell::CommandEvent e;
+  e.command_id(text("command_id"));
+  e.resource_id(text("resource_id"));
+  e.order_id(text("order_id"));
+  e.operation(text("operation"));
+  e.part(text("part"));
+  const std::string state = text("state");
+  bool known = false;
+  for (auto s : {cell::ACCEPTED, cell::EXECUTING, cell::CANCELING, cell::SUCCEEDED, cell::CANCELED, cell::ABORTED}) {
+    if (state == state_name(s)) e.state(s), known = true;
+  }
+  if (!known) throw std::invalid_argument("no command state '" + state + "'");
+  e.progress(e.state() == cell::SUCCEEDED ? 1.0 : 0.0);
+  e.reason(text("reason"));
+  e.sim_time(fb::get_or<double>(d, "sim_time", 0));
+  e.distance(fb::get_or<double>(d, "distance", 0));
+  e.duration(fb::get_or<double>(d, "duration", 0));
+  return e;
+}
+
 fb::Data to_data(const cell::Command& c) {
   return {{"command_id", c.command_id()},   {"resource_id", c.resource_id()}, {"order_id", c.order_id()},
           {"operation", c.operation()},     {"part", c.part()},               {"part_type", c.part_type()},

@@ -34,6 +34,9 @@ fb::Data to_data(const cell::SimReply& reply);
 cell::SimRequest to_sim_request(const fb::Data& data);  // carried: comma-separated body ids
 fb::Data to_data(const cell::SimRequest& request);
 cell::SimReply to_sim_reply(const fb::Data& data);
+// A command's event from its command's fields and the event's (state by name, reason,
+// sim_time, distance, duration); throws std::invalid_argument for an unknown state.
+cell::CommandEvent to_command_event(const fb::Data& data);
 
 
 // The contract net's messages, as the Contractor and Negotiator blocks take them; lists

@@ -48,8 +48,13 @@ class Writer : private fdds::DataWriterListener {
     writer_ = publisher_->create_datawriter(topic_on<PubSubType>(*participant_, topic), writer_qos(kind, settings), this);
     if (!writer_) throw std::runtime_error("cannot create a writer on " + topic);
   }
+  // A matched callback already under way finishes first; later ones find the writer closed.
   ~Writer() override {
     writer_->set_listener(nullptr);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closed_ = true;
+    }
     publisher_->delete_datawriter(writer_);
     participant_->delete_publisher(publisher_);
   }
@@ -66,11 +71,10 @@ class Writer : private fdds::DataWriterListener {
 
  private:
   void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      matched_ = status.current_count;
-    }
-    matched_changed_.notify_all();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return;
+    matched_ = status.current_count;
+    matched_changed_.notify_all();  // under the lock: the destructor cannot take the condition away meanwhile
   }
 
   ParticipantPtr participant_;
@@ -79,6 +83,7 @@ class Writer : private fdds::DataWriterListener {
   std::mutex mutex_;
   std::condition_variable matched_changed_;
   int matched_ = 0;
+  bool closed_ = false;
 };
 
 template <class T, class PubSubType>

@@ -3,6 +3,7 @@
 // capabilities; asks a buffer for a part with a "give" command.
 //   mobile-robot --domain 42 --id mobile-robot-1 --home 1.5 0 1.2 --speed 0.8
 
+#include <atomic>
 #include <csignal>
 #include <iostream>
 
@@ -18,8 +19,9 @@
 #include "services/node/run.hpp"
 
 namespace {
-volatile std::sig_atomic_t running = 1;
-void stop(int) { running = 0; }
+// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
+std::atomic<bool> running{true};
+void stop(int) { running = false; }
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -55,7 +55,6 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   transition("READY", "START", "TO_SOURCE", [this](const Data& d) {
     fetch_ = d;
     distance_ = moving_ = 0;
-    emit("PROGRESS", {{"progress", 0.0}});
     drive_to(get<std::string>(d, "source"), {});
   }, knows_places);
   transition("READY", "START", "READY", [this](const Data& d) {

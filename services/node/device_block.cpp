@@ -14,6 +14,19 @@ DeviceBlock::DeviceBlock(std::string name, std::string resource_id, std::set<std
   declare_output("PROGRESS", {"progress"});
   declare_output("DONE");
   declare_output("FAIL", {"reason"});
+  declare_output("REPEAT", {"command_id", "state"});
+}
+
+void DeviceBlock::ended(const std::string& command_id, const Data& last_event) {
+  constexpr std::size_t kRemembered = 1024;
+  Data record = command(command_id);
+  for (const auto& [key, value] : last_event) record[key] = value;
+  commands_.erase(command_id);
+  if (ended_.emplace(command_id, std::move(record)).second) ended_order_.push_back(command_id);
+  if (ended_order_.size() > kRemembered) {
+    ended_.erase(ended_order_.front());
+    ended_order_.pop_front();
+  }
 }
 
 const Data& DeviceBlock::command(const std::string& command_id) const {
@@ -28,6 +41,8 @@ void DeviceBlock::receive(const Event& event) {
     // Every command for this resource is accepted; one for an operation it lacks fails at
     // START with the reason, so the sender hears why.
     const std::string& id = get<std::string>(event.data, "command_id");
+    if (commands_.count(id)) return;
+    if (const auto done = ended_.find(id); done != ended_.end()) return emit("REPEAT", done->second);
     commands_[id] = event.data;
     emit("ACCEPT", {{"command_id", id}});
     return;

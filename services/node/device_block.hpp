@@ -8,12 +8,16 @@
 //   inputs                                  outputs
 //   COMMAND (command_id, resource_id,       ACCEPT   (command_id)    to the life cycle
 //            operation, ...)                PROGRESS, DONE, FAIL     to the life cycle
+//   A command that comes again (its sender heard nothing of it: a DDS match that was not
+//   complete yet) is not carried out twice: while it is under way it is ignored (its events
+//   will come); once it has ended, REPEAT gives its last event again.
 //   START   (command_id) -> the ECC's START with the command's data; a command of an order
 //           that has ended meanwhile fails at once ("order X has ended"), so a queue of
 //           work for a failed order drains instead of being carried out
 //   ORDER_ENDED, ORDER_ACTIVE (order_id): from the orders' status (an id may come again)
 // A device adds its own inputs and outputs (replies from cell-sim, requests to it).
 
+#include <deque>
 #include <map>
 #include <set>
 
@@ -28,9 +32,10 @@ class DeviceBlock : public BasicBlock {
 
   const std::string& resource_id() const { return resource_id_; }
   const std::set<std::string>& operations() const { return operations_; }
-  // The command as it came (empty when unknown); forget() once its last event is out.
+  // The command as it came (empty when unknown); ended() once its last event is out, with
+  // that event's data (state, reason, ...), which REPEAT gives again if the command comes again.
   const Data& command(const std::string& command_id) const;
-  void forget(const std::string& command_id) { commands_.erase(command_id); }
+  void ended(const std::string& command_id, const Data& last_event);
 
   void receive(const Event& event) override;
 
@@ -42,6 +47,8 @@ class DeviceBlock : public BasicBlock {
   std::string resource_id_;
   std::set<std::string> operations_;
   std::map<std::string, Data> commands_;
+  std::map<std::string, Data> ended_;    // command id -> its command and last event, the newest few
+  std::deque<std::string> ended_order_;  // oldest first
   std::set<std::string> ended_orders_;
 };
 

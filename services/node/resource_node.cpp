@@ -95,7 +95,12 @@ struct ResourceNode::Impl {
     clock.observe(fb::get_or<double>(command, "sim_time", 0));
     if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
     e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
-    if (is_final(state)) device.forget(id);
+    if (is_final(state)) {
+      fb::Data last = d;
+      last["state"] = std::string(dds::state_name(state));
+      last["sim_time"] = e.sim_time();
+      device.ended(id, last);
+    }
     const std::size_t queued = lifecycle->queued();
     if ((lifecycle->state() != "IDLE") != busy || queued != queued_published) {
       busy = lifecycle->state() != "IDLE";
@@ -130,6 +135,9 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.connect(dev, "ACCEPT", "lifecycle", "COMMAND");
   resource.connect("lifecycle", "START", dev, "START");
   for (const char* e : {"PROGRESS", "DONE", "FAIL"}) resource.connect(dev, e, "lifecycle", e);
+  n.publish<cell::CommandEvent, cell::CommandEventPubSubType>("event_repeat", "cell/command_events",
+                                                             [](const fb::Data& d) { return dds::to_command_event(d); });
+  resource.connect(dev, "REPEAT", "event_repeat", "REQ");
   for (const auto& [output, state] : kLifecycleOutputs) {
     const std::string name = std::string("event_") + output;
     const cell::CommandState s = state;

@@ -3,7 +3,7 @@
 // of its own, delivering its events one at a time.
 
 #include <chrono>
-#include <csignal>
+#include <atomic>
 #include <thread>
 #include <vector>
 
@@ -11,7 +11,7 @@
 
 namespace services {
 
-inline void run_until_stopped(const std::vector<fb::Resource*>& resources, const volatile std::sig_atomic_t& running) {
+inline void run_until_stopped(const std::vector<fb::Resource*>& resources, const std::atomic<bool>& running) {
   std::vector<std::thread> threads;
   for (fb::Resource* r : resources) {
     threads.emplace_back([r, &running] {

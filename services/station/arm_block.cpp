@@ -28,7 +28,6 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
     transition("READY", "START", "MOVING", [this](const Data& d) {
       std::vector<std::string> carried{carriage()};
       if (!held_.empty()) carried.push_back(held_);
-      emit("PROGRESS", {{"progress", 0.0}});
       awaited_ = 1;
       request(sim_.move(pad(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
     }, op(motion));

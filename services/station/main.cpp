@@ -3,6 +3,7 @@
 // grips, moves, releases, connects and disconnects parts in cell-sim.
 //   station --domain 42 --id station-1 --arm-id arm-1 --position 0 0 0 --dock 0.6 0 0
 
+#include <atomic>
 #include <csignal>
 #include <iostream>
 
@@ -15,8 +16,9 @@
 #include "services/station/station_block.hpp"
 
 namespace {
-volatile std::sig_atomic_t running = 1;
-void stop(int) { running = 0; }
+// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
+std::atomic<bool> running{true};
+void stop(int) { running = false; }
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -4,6 +4,7 @@
 // collision. The sim clock goes out on cell/clock.
 //   cell-sim --domain 42 --real-time-factor 20
 
+#include <atomic>
 #include <csignal>
 #include <iostream>
 
@@ -17,8 +18,9 @@
 #include "simulationPubSubTypes.h"
 
 namespace {
-volatile std::sig_atomic_t running = 1;
-void stop(int) { running = 0; }
+// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
+std::atomic<bool> running{true};
+void stop(int) { running = false; }
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -3,9 +3,10 @@
 //     function blocks) between this process and an echo child;
 //  2. a command's round trip from a sender to a resource process (a buffer: commands topic,
 //     function-block resource, life cycle, command events) until SUCCEEDED;
-//  3. the time from starting a twin to its first status, and to it having planned, found
-//     cell-sim and begun negotiating.
-// Prints p50 and p99 of each. Run: build/release/bin/bench_cell [--rounds N]
+//  3. the time from starting a twin to its first status, and to it having planned, heard
+//     cell-sim answer and begun virtual assembly (over --launches twin starts);
+//  4. 1 and 2 again while `cellctl run` assembles 10 orders on the default cell.
+// Prints p50 and p99 of each. Run: build/release/bin/bench_cell [--rounds N] [--launches N]
 //   (internal: bench_cell --echo DOMAIN is the ping-pong's other side)
 
 #include <algorithm>
@@ -29,8 +30,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-volatile std::sig_atomic_t running = 1;
-void stop(int) { running = 0; }
+// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
+std::atomic<bool> running{true};
+void stop(int) { running = false; }
 
 using CommandWriter = dds::Writer<cell::Command, cell::CommandPubSubType>;
 using CommandReader = dds::Reader<cell::Command, cell::CommandPubSubType>;
@@ -104,9 +106,10 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
   return us;
 }
 
-// With cell-sim running (the twin waits for it before negotiating) and no other resource.
+// With cell-sim and a station running (the twin needs both before virtual assembly).
 void twin_start(int domain, int rounds) {
   test::ChildProcess sim({CELL_SIM_EXE, "--domain", std::to_string(domain)}, "/dev/null");
+  test::ChildProcess station({STATION_EXE, "--domain", std::to_string(domain)}, "/dev/null");
   auto participant = dds::make_participant("bench-observer", {domain, true});
   std::mutex mutex;
   std::condition_variable changed;
@@ -135,11 +138,10 @@ void twin_start(int domain, int rounds) {
     if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
       first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
     }
-    // Planned, cell-sim found: the twin calls for proposals (and, with no resources here,
-    // waits for them until --wait runs out).
+    // Planned, cell-sim answered, a station known: virtual assembly begins.
     const auto negotiating = [&] {
       const auto it = seen.find(order);
-      return it != seen.end() && it->second.message() == "calling for proposals";
+      return it != seen.end() && it->second.state() >= cell::VIRTUAL_ASSEMBLY;
     };
     if (changed.wait_for(lock, 10s, negotiating)) {
       planned.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
@@ -147,17 +149,50 @@ void twin_start(int domain, int rounds) {
     lock.unlock();
     twin.stop();
   }
+  station.stop();
   sim.stop();
   report("twin start to its first status (Cranfield)", first_status);
-  report("twin start to planned, cell-sim found, negotiating (Cranfield)", planned);
+  report("twin start to planned, cell-sim answered, virtual assembly begun (Cranfield)", planned);
+  std::cout << "  slowest start " << *std::max_element(planned.begin(), planned.end()) / 1000 << " ms; "
+            << rounds - planned.size() << " starts never got there within 10 s" << std::endl;
+}
+
+// The round trips while a cell assembles 10 orders on the same host (the bench's echo and
+// buffer on a domain of their own, the cell on another).
+void under_load(const char* self, int domain, int rounds) {
+  std::vector<std::string> args{CELLCTL_EXE, "run", "--domain", std::to_string(domain + 2)};
+  for (int i = 0; i < 10; ++i) {
+    args.push_back(std::string(PRODUCTS_DIR) + (i % 2 == 0 ? "/lego-tower/lego-tower.aml" : "/cranfield/cranfield.aml"));
+  }
+  args.insert(args.end(), {"--out", "/tmp/bench-cell-load"});
+  test::ChildProcess cell(args, "/tmp/bench-cell-load.log");
+  std::this_thread::sleep_for(3s);  // the cell is up and the twins plan and assemble virtually
+  auto participant = dds::make_participant("bench", {domain, true});
+  {
+    test::ChildProcess echo_side({self, "--echo", std::to_string(domain)});
+    report("while 10 orders run: bare Fast DDS ping-pong", round_trips(participant, "bench/ping", "bench/pong", "echo", rounds));
+    echo_side.stop();
+  }
+  {
+    test::ChildProcess buffer({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(domain), "--stock",
+                               "Part=1000000"});
+    report("while 10 orders run: command to SUCCEEDED, buffer process",
+           round_trips(participant, "cell/commands", "cell/command_events", "bench-buffer", rounds));
+    buffer.stop();
+  }
+  const int code = cell.wait_for_exit(std::chrono::minutes(5));
+  std::cout << "  (the 10 orders' cellctl run ended with exit " << code << ")" << std::endl;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 3 && std::strcmp(argv[1], "--echo") == 0) return echo(std::stoi(argv[2]));
-  int rounds = 1000;
-  if (argc == 3 && std::strcmp(argv[1], "--rounds") == 0) rounds = std::stoi(argv[2]);
+  int rounds = 1000, launches = 100;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (std::strcmp(argv[i], "--rounds") == 0) rounds = std::stoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--launches") == 0) launches = std::stoi(argv[i + 1]);
+  }
   test::clean_stale_dds_segments();
   const int domain = 199;
   try {
@@ -174,7 +209,9 @@ int main(int argc, char** argv) {
                                                                  "bench-buffer", rounds));
       buffer.stop();
     }
-    twin_start(domain + 1, 10);
+    twin_start(domain + 1, launches);
+    participant.reset();
+    under_load(argv[0], domain + 3, rounds / 2);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << '\n';
     return 1;

@@ -61,7 +61,6 @@ bool is_final(const std::string& event) { return event == "succeeded" || event =
 struct CellFacts {
   std::map<std::string, double> speed;
   std::map<std::string, std::string> station_of_arm;
-  std::set<std::string> robots;
 };
 
 CellFacts facts_of(const std::string& cell_file) {
@@ -79,7 +78,6 @@ CellFacts facts_of(const std::string& cell_file) {
   }
   for (const auto& r : list("mobile_robot", "mobile_robots")) {
     f.speed[r["id"].as<std::string>()] = r["speed"].as<double>();
-    f.robots.insert(r["id"].as<std::string>());
   }
   return f;
 }
@@ -120,16 +118,14 @@ void check_event_log(const std::vector<json>& events, const std::map<std::string
   }
 
   // One command at a time per resource: [start, end] intervals in sim time do not overlap.
-  // The start is EXECUTING for devices that queue (mobile robots), else ACCEPTED.
+  // A command starts when it is EXECUTING (it may have waited in a queue since ACCEPTED).
   struct Span {
     double start = -1, end = -1;
   };
   std::map<std::string, std::map<std::string, Span>> spans;  // resource -> command -> span
   for (const auto& e : events) {
     Span& s = spans[e["resource"]][e["command"]];
-    if (e["event"] == "executing" || (e["event"] == "accepted" && !cell.robots.count(e["resource"]))) {
-      if (s.start < 0) s.start = e["t"];
-    }
+    if (e["event"] == "executing" && s.start < 0) s.start = e["t"];
     if (is_final(e["event"])) s.end = e["t"];
   }
   for (const auto& [resource, commands] : spans) {

@@ -93,7 +93,7 @@ TEST_CASE("an ECC fires the first transition whose event and guard match", "[fb]
 TEST_CASE("command life cycle: accepted, executing, succeeded", "[fb][lifecycle]") {
   fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
   const auto accepted = f.send("COMMAND", {{"command_id", std::string("c1")}});
-  CHECK(names<fb::CommandLifecycle>(accepted) == Names{"ACCEPTED", "START"});
+  CHECK(names<fb::CommandLifecycle>(accepted) == Names{"ACCEPTED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(accepted[0].data, "command_id") == "c1");
   const auto progress = f.send("PROGRESS", {{"progress", 0.5}});
   REQUIRE(names<fb::CommandLifecycle>(progress) == Names{"EXECUTING"});
@@ -113,7 +113,7 @@ TEST_CASE("command life cycle: one command at a time, and failures carry their r
   REQUIRE(names<fb::CommandLifecycle>(aborted) == Names{"ABORTED", "IDLE"});
   CHECK(fb::get<std::string>(aborted[0].data, "reason") == "collision with B6");
   CHECK(names<fb::CommandLifecycle>(f.send("COMMAND", {{"command_id", std::string("c2")}})) ==
-        Names{"ACCEPTED", "START"});
+        Names{"ACCEPTED", "EXECUTING", "START"});
 }
 
 TEST_CASE("command life cycle: cancel, and a device that finishes before it can stop", "[fb][lifecycle]") {
@@ -150,12 +150,12 @@ TEST_CASE("command life cycle with a queue: one executes, the rest wait their tu
   f.send("COMMAND", {{"command_id", std::string("c3")}});
   CHECK(f.block().queued() == 2);
   const auto done = f.send("DONE", {{"distance", 1.5}});
-  REQUIRE(names<fb::CommandLifecycle>(done) == Names{"SUCCEEDED", "START"});
+  REQUIRE(names<fb::CommandLifecycle>(done) == Names{"SUCCEEDED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(done[0].data, "command_id") == "c1");
   CHECK(fb::get<double>(done[0].data, "distance") == 1.5);  // the device's data goes along
   CHECK(fb::get<std::string>(done[1].data, "command_id") == "c2");
   const auto failed = f.send("FAIL", {{"reason", std::string("buffer-1 has no Peg")}});
-  REQUIRE(names<fb::CommandLifecycle>(failed) == Names{"ABORTED", "START"});
+  REQUIRE(names<fb::CommandLifecycle>(failed) == Names{"ABORTED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(failed[1].data, "command_id") == "c3");
   CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
@@ -170,6 +170,6 @@ TEST_CASE("command life cycle with a queue: a queued command is canceled at once
   REQUIRE(names<fb::CommandLifecycle>(canceled) == Names{"CANCELED"});
   CHECK(fb::get<std::string>(canceled[0].data, "command_id") == "c2");
   const auto next = f.send("DONE");
-  REQUIRE(names<fb::CommandLifecycle>(next) == Names{"SUCCEEDED", "START"});
+  REQUIRE(names<fb::CommandLifecycle>(next) == Names{"SUCCEEDED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(next[1].data, "command_id") == "c3");  // c2 is gone
 }

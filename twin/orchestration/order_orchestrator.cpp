@@ -117,6 +117,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   transition("PHYSICAL", "COMMAND_EVENT", "PHYSICAL", [this](const Data& d) {
     if (get<std::string>(d, "order_id") != settings_.order_id) return;
     const std::string& id = get<std::string>(d, "command_id");
+    unheard_.erase(id);
     const std::string& state = get<std::string>(d, "state");
     if (const auto fetch = fetch_of_.find(id); fetch != fetch_of_.end()) {
       if (state == "succeeded") {
@@ -134,13 +135,16 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
          " failed: " + get<std::string>(d, "reason"));
   });
   transition("CLEANUP", "COMMAND_EVENT", "CLEANUP", [this](const Data& d) {
+    unheard_.erase(get<std::string>(d, "command_id"));
     if (action_running_ && get<std::string>(d, "command_id") == awaited_id_ &&
         get<std::string>(d, "state") != "accepted" && get<std::string>(d, "state") != "executing") {
       action_done();
     }
   });
+  transition("PHYSICAL", "TICK", "PHYSICAL", [this](const Data&) { resend_unheard(); });
   transition("CLEANUP", "TICK", "CLEANUP", [this](const Data&) {
-    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) finish();
+    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) return finish();
+    resend_unheard();
   });
 }
 
@@ -476,9 +480,9 @@ void OrderOrchestrator::next_action() {
         return emit("SIM", a.data);
       case Action::command:
         awaited_id_ = get<std::string>(a.data, "command_id");
-        return emit("COMMAND", a.data);
+        return send_command(a.data);
       case Action::send_only:
-        emit("COMMAND", a.data);
+        send_command(a.data);
         actions_.pop_front();
         continue;
       case Action::await_delivery:
@@ -530,6 +534,20 @@ void OrderOrchestrator::action_done() {
   actions_.pop_front();
   action_running_ = false;
   next_action();
+}
+
+void OrderOrchestrator::send_command(const Data& command) {
+  unheard_[get<std::string>(command, "command_id")] = {command, std::chrono::steady_clock::now()};
+  emit("COMMAND", command);
+}
+
+void OrderOrchestrator::resend_unheard() {
+  const auto now = std::chrono::steady_clock::now();
+  for (auto& [id, sent] : unheard_) {
+    if (now - sent.at < settings_.resend_after) continue;
+    sent.at = now;
+    emit("COMMAND", sent.command);
+  }
 }
 
 void OrderOrchestrator::fail(const std::string& reason) {

@@ -57,6 +57,10 @@ struct OrderSettings {
   std::string order_id;
   std::chrono::milliseconds wait_timeout{30000};  // for the cell, and for each call but a station's queue
   std::chrono::milliseconds cleanup_timeout{5000};
+  // A command nothing was heard of is sent again (the resource carries it out once): DDS
+  // matches each pair of endpoints on its own, and a young twin's first commands or a
+  // resource's first events may find the other side not matched yet.
+  std::chrono::milliseconds resend_after{2000};
   double arm_speed = 0.25;          // m/s: virtual assembly's moves, until an arm's capability says
   double arm_angular_speed = 1.0;   // rad/s
   fb::GripperSize gripper;
@@ -107,6 +111,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   void on_collision(const std::string& reason);
   // No trajectory of the current step's part works in cell-sim: plan the rest again.
   void back_to_sequence_planning();
+  void send_command(const fb::Data& command);
+  void resend_unheard();
   void fail(const std::string& reason);
   void finish();
   void status(const std::string& state, const std::string& message, double progress);
@@ -140,6 +146,11 @@ class OrderOrchestrator : public fb::BasicBlock {
   long ahead_ = -1;                               // in the station's queue, as last reported
   bool arm_held_ = false;
   std::set<std::string> delivered_, spawned_;
+  struct Sent {
+    fb::Data command;
+    std::chrono::steady_clock::time_point at;
+  };
+  std::map<std::string, Sent> unheard_;  // commands sent that no event has answered yet
   std::map<std::string, PartIndex> fetch_of_;
   std::string error_;
 };

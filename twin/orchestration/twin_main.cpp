@@ -5,6 +5,7 @@
 //   twin --domain 42 --order o1 --product deploy/products/cranfield/cranfield.aml --out out/o1
 // Exit codes: 0 assembled, 1 the order failed, 2 bad input.
 
+#include <atomic>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -31,8 +32,9 @@
 
 namespace {
 
-volatile std::sig_atomic_t running = 1;
-void stop(int) { running = 0; }
+// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
+std::atomic<bool> running{true};
+void stop(int) { running = false; }
 
 using dds::TopicKind;
 
