@@ -83,7 +83,9 @@ class RunningCell {
   }
 
   void stop() {
-    for (auto it = processes_.rbegin(); it != processes_.rend(); ++it) (*it)->stop();
+    std::vector<Process*> all;
+    for (auto& p : processes_) all.push_back(p.get());
+    stop_all(all);
     processes_.clear();
   }
 
@@ -162,13 +164,15 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   }
   for (std::size_t running = orders.size(); running > 0;) {
     running = 0;
+    std::vector<Process*> twins;
     for (auto& order : orders) {
       if (order.exit_code >= 0) continue;
-      if (stop_requested) order.twin->stop();
+      twins.push_back(order.twin.get());
       order.peak_rss_kb = std::max(order.peak_rss_kb, order.twin->peak_rss_kb());
       order.exit_code = order.twin->poll();
       running += order.exit_code < 0;
     }
+    if (stop_requested && running > 0) stop_all(twins);  // each says why it stopped, at once
     std::this_thread::sleep_for(50ms);
   }
   observer.on_status({});

@@ -64,6 +64,19 @@ int Process::stop(std::chrono::milliseconds grace) {
   return wait();
 }
 
+void Process::terminate() {
+  if (poll() < 0) ::kill(pid_, SIGTERM);
+}
+
+void stop_all(const std::vector<Process*>& processes, std::chrono::milliseconds grace) {
+  for (Process* p : processes) p->terminate();
+  const auto deadline = std::chrono::steady_clock::now() + grace;
+  for (Process* p : processes) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    p->stop(std::max(left, std::chrono::milliseconds(0)));
+  }
+}
+
 long Process::peak_rss_kb() const {
   std::ifstream status("/proc/" + std::to_string(pid_) + "/status");
   for (std::string line; std::getline(status, line);) {

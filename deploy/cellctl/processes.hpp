@@ -24,6 +24,8 @@ class Process {
   int wait();
   // SIGTERM, up to `grace`, then SIGKILL; its exit code.
   int stop(std::chrono::milliseconds grace = std::chrono::seconds(5));
+  // SIGTERM and no wait (stop() several processes at once: terminate() each, then stop()).
+  void terminate();
   // Peak resident memory so far (VmHWM), kB; 0 when unknown.
   long peak_rss_kb() const;
 
@@ -32,6 +34,9 @@ class Process {
   pid_t pid_ = -1;
   int exit_code_ = -1;
 };
+
+// Stops them all at once: SIGTERM to each, then each waited for up to `grace` (then SIGKILL).
+void stop_all(const std::vector<Process*>& processes, std::chrono::milliseconds grace = std::chrono::seconds(5));
 
 // The folder cellctl runs from: the other executables are beside it.
 std::string executable_dir();

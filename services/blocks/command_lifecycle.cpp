@@ -28,7 +28,6 @@ CommandLifecycle::CommandLifecycle(std::string name, WhenBusy when_busy) : Basic
   transition("IDLE", "COMMAND", "EXECUTING", [this](const Data& d) {
     command_ = get<std::string>(d, "command_id");
     emit("ACCEPTED", with_id({}));
-    emit("EXECUTING", with_id({{"progress", 0.0}}));
     emit("START", with_id({}));
   });
   transition("EXECUTING", "PROGRESS", "EXECUTING", [this](const Data& d) { emit("EXECUTING", with_id(d)); });

@@ -16,7 +16,8 @@
 //                                  CANCELED              (command_id)
 //                                  REJECTED              (command_id, reason)
 //                                  IDLE: nothing executes and nothing waits any more
-// A command that starts is EXECUTING (progress 0) at once, whether it waited or not.
+// A command accepted while the device is free starts at once (ACCEPTED says both); one that
+// waited in the queue is EXECUTING (progress 0) when it starts.
 // CANCEL of a queued command takes it out at once (CANCELED); of the executing one, asks the
 // device to STOP (a device that finishes first: its outcome stands).
 // Data the device adds to PROGRESS, DONE and FAIL (a sim time, a distance) goes out with

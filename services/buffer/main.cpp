@@ -10,6 +10,7 @@
 
 #include "services/buffer/buffer_service.hpp"
 #include "services/dds/cli_options.hpp"
+#include "services/node/run.hpp"
 
 namespace {
 // Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
+  services::stop_with_parent();
   try {
     services::BufferService service(config);
     std::cout << "buffer " << config.node.id << " ready on domain " << config.dds.domain_id << std::endl;

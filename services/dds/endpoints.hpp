@@ -2,12 +2,14 @@
 // Typed DDS writers and readers on a participant, with the QoS of their topic kind.
 // T is a fastddsgen type, PubSubType its generated TypeSupport class.
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -99,13 +101,11 @@ class Reader : private fdds::DataReaderListener {
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic);
   }
-  // A listener callback already under way finishes first; later ones find the reader closed.
+  // A drain already under way finishes first; later callbacks find the reader closed.
   ~Reader() override {
     reader_->set_listener(nullptr);
-    {
-      std::lock_guard<std::mutex> lock(drain_mutex_);
-      closed_ = true;
-    }
+    closed_ = true;
+    while (requests_ != 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     subscriber_->delete_datareader(reader_);
     participant_->delete_subscriber(subscriber_);
   }
@@ -113,6 +113,8 @@ class Reader : private fdds::DataReaderListener {
   Reader& operator=(const Reader&) = delete;
 
  private:
+  // The reader comes with the callback: during create_datareader a writer of this process
+  // may deliver to it already, before reader_ is set.
   void on_data_available(fdds::DataReader* reader) override { drain(reader); }
   // A writer that leaves or dies changes its instances' state; Fast DDS 2.9 does not always
   // announce that through on_data_available, so look then too.
@@ -123,12 +125,24 @@ class Reader : private fdds::DataReaderListener {
     if (status.not_alive_count_change > 0) drain(reader);
   }
 
+  // Callbacks come on several Fast DDS threads, some holding the reader's own lock (data)
+  // and some not (matching, liveliness). One thread drains at a time, and the others never
+  // wait for it: they count a request and leave, and the draining thread goes round again
+  // until no request is left. (A mutex here deadlocked against Fast DDS's reader lock: one
+  // thread held it and waited for ours, ours waited for it in return_loan.)
+  void drain(fdds::DataReader* reader) {
+    if (requests_.fetch_add(1) != 0) return;  // the draining thread will go round again
+    int served = 0;
+    do {
+      served = requests_.load();
+      if (!closed_) drain_once(reader);
+    } while (requests_.fetch_sub(served) != served);
+  }
+
   // Event topics: take every new sample. State topics: read new samples but keep the last
   // one per instance, so that when an instance's writers are gone (its state turns
   // NOT_ALIVE) the kept sample tells which instance it was; then take it.
-  void drain(fdds::DataReader* reader) {
-    std::lock_guard<std::mutex> lock(drain_mutex_);
-    if (closed_) return;
+  void drain_once(fdds::DataReader* reader) {
     fdds::LoanableSequence<T> samples;
     fdds::SampleInfoSeq infos;
     const auto visit = [&](auto&& each) {
@@ -156,8 +170,8 @@ class Reader : private fdds::DataReaderListener {
   TopicKind kind_;
   std::function<void(const T&)> on_sample_;
   std::function<void(const T&)> on_gone_;
-  std::mutex drain_mutex_;
-  bool closed_ = false;
+  std::atomic<int> requests_{0};  // drain calls not yet served
+  std::atomic<bool> closed_{false};
   fdds::Subscriber* subscriber_ = nullptr;
   fdds::DataReader* reader_ = nullptr;
 };

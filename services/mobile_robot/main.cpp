@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   dds::apply_interfaces(dds, all_interfaces);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
+  services::stop_with_parent();
   try {
     auto participant = dds::make_participant(config.id, dds);
     fb::Resource resource(config.id, 1024);

@@ -1,5 +1,7 @@
 #include "services/node/resource_node.hpp"
 
+#include <thread>
+
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "negotiationPubSubTypes.h"
@@ -7,6 +9,7 @@
 #include "services/dds/conversions.hpp"
 #include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
+#include "services/node/sim_requests.hpp"
 #include "simulationPubSubTypes.h"
 
 namespace services {
@@ -25,6 +28,36 @@ const std::pair<const char*, cell::CommandState> kLifecycleOutputs[] = {
 
 bool is_final(cell::CommandState s) { return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED; }
 
+// Publishes the capability once the events queued before are through: a command's events go
+// out first (a commander waits for them, not for the capability), and a command done at
+// once (a buffer's give) leaves nothing to say about busy or idle.
+//   CHECK: publish if busy, idle or the queue changed;  CHANGED: publish (a stock changed)
+class CapabilityRefresh : public fb::FunctionBlock {
+ public:
+  CapabilityRefresh(std::string name, std::function<void(bool force)> refresh)
+      : FunctionBlock(std::move(name)), refresh_(std::move(refresh)) {
+    declare_input("CHECK");
+    declare_input("CHANGED");
+    declare_input("LATER");
+  }
+  void receive(const fb::Event& e) override {
+    if (e.name == "LATER") {
+      pending_ = false;
+      refresh_(force_);
+      force_ = false;
+      return;
+    }
+    force_ |= e.name == "CHANGED";
+    if (pending_) return;
+    pending_ = true;
+    post_to_self("LATER");
+  }
+
+ private:
+  std::function<void(bool)> refresh_;
+  bool pending_ = false, force_ = false;
+};
+
 
 }  // namespace
 
@@ -40,6 +73,8 @@ struct ResourceNode::Impl {
   std::vector<std::function<void()>> starters;
   Pub<cell::SimRequest, cell::SimRequestPubSubType>* sim_requests = nullptr;
   fb::CommandLifecycle* lifecycle = nullptr;
+  std::string ping_id;
+  bool sim_answers = false;
   bool busy = false;  // as last published
   std::size_t queued_published = 0;
 
@@ -101,13 +136,17 @@ struct ResourceNode::Impl {
       last["sim_time"] = e.sim_time();
       device.ended(id, last);
     }
-    const std::size_t queued = lifecycle->queued();
-    if ((lifecycle->state() != "IDLE") != busy || queued != queued_published) {
-      busy = lifecycle->state() != "IDLE";
-      queued_published = queued;
-      publish_capability();
-    }
     return e;
+  }
+
+  // After an event is out: the capability again if the resource turned busy or idle, or its
+  // queue changed (not before: the event is what a commander waits for).
+  void refresh_capability(bool force) {
+    const std::size_t queued = lifecycle->queued();
+    if (!force && (lifecycle->state() != "IDLE") == busy && queued == queued_published) return;
+    busy = lifecycle->state() != "IDLE";
+    queued_published = queued;
+    publish_capability();
   }
 };
 
@@ -138,12 +177,14 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   n.publish<cell::CommandEvent, cell::CommandEventPubSubType>("event_repeat", "cell/command_events",
                                                              [](const fb::Data& d) { return dds::to_command_event(d); });
   resource.connect(dev, "REPEAT", "event_repeat", "REQ");
+  resource.add(std::make_unique<CapabilityRefresh>("capability_refresh", [&n](bool force) { n.refresh_capability(force); }));
   for (const auto& [output, state] : kLifecycleOutputs) {
     const std::string name = std::string("event_") + output;
     const cell::CommandState s = state;
     n.publish<cell::CommandEvent, cell::CommandEventPubSubType>(
         name, "cell/command_events", [&n, s](const fb::Data& d) { return n.event_of(s, d); });
     resource.connect("lifecycle", output, name, "REQ");
+    resource.connect(name, "CNF", "capability_refresh", "CHECK");
   }
 
   // The contract net.
@@ -178,7 +219,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.connect("contractor", "REPLY", "award_replies", "REQ");
   resource.add(std::make_unique<fb::ActionBlock>("capability", [this](const fb::Data&) { publish_capability(); }));
   resource.connect("contractor", "RESERVED", "capability", "REQ");
-  if (device.has_output("CAPABILITY")) resource.connect(dev, "CAPABILITY", "capability", "REQ");
+  if (device.has_output("CAPABILITY")) resource.connect(dev, "CAPABILITY", "capability_refresh", "CHANGED");
 
   // cell-sim, for devices that move things.
   if (device.has_output("SIM")) {
@@ -189,19 +230,41 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
                                                           [](const cell::SimReply& r) { return dds::to_data(r); });
     resource.connect(dev, "SIM", "sim_requests", "REQ");
     resource.connect("sim_replies", "IND", dev, "SIM_REPLY");
+    resource.add(std::make_unique<fb::ActionBlock>("sim_ping", [&n](const fb::Data& reply) {
+      if (fb::get<std::string>(reply, "request_id") == n.ping_id) n.sim_answers = true;
+    }));
+    resource.connect("sim_replies", "IND", "sim_ping", "REQ");
   }
 }
 
 ResourceNode::~ResourceNode() = default;
 
 void ResourceNode::start(std::chrono::milliseconds wait_for_sim) {
+  Impl& n = *impl_;
+  const auto gone = [&] {
+    return std::runtime_error("cell-sim did not answer within " + std::to_string(wait_for_sim.count() / 1000) +
+                              " s on this domain");
+  };
   // Requests are events, lost if nobody listens yet: a device that moves things needs cell-sim.
-  if (impl_->sim_requests && !impl_->sim_requests->writer().wait_for_readers(1, wait_for_sim)) {
-    throw std::runtime_error("cell-sim did not appear within " + std::to_string(wait_for_sim.count() / 1000) +
-                             " s on this domain");
-  }
+  const auto deadline = std::chrono::steady_clock::now() + wait_for_sim;
+  if (n.sim_requests && !n.sim_requests->writer().wait_for_readers(1, wait_for_sim)) throw gone();
   publish_capability();
-  for (auto& start : impl_->starters) start();
+  for (auto& start : n.starters) start();
+  if (!n.sim_requests) return;
+  // And its replies must reach this process: DDS matches each pair of endpoints on its own,
+  // and a device whose first reply was lost (its spawn) never became ready. Pinged until it
+  // answers, on this thread, before the resource's own thread runs.
+  fb::SimRequests pings(n.config.id + "/node");
+  for (int round = 0; !n.sim_answers; ++round) {
+    if (std::chrono::steady_clock::now() > deadline) throw gone();
+    if (round % 10 == 0) {
+      const fb::Data ping = pings.ping();
+      n.ping_id = fb::get<std::string>(ping, "request_id");
+      n.resource.post("sim_requests", "REQ", ping);
+    }
+    n.resource.run_until_idle();
+    if (!n.sim_answers) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
 }
 
 dds::SimClock& ResourceNode::clock() { return impl_->clock; }

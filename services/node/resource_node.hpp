@@ -54,8 +54,9 @@ class ResourceNode {
                fb::Contractor::EstimateFn estimate, std::function<void(cell::Capability&)> describe = {});
   ~ResourceNode();
 
-  // Starts listening to the topics; call once everything is wired. A device that moves
-  // things first waits for cell-sim; throws std::runtime_error if it does not come.
+  // Starts listening to the topics; call once everything is wired, before the resource's
+  // thread runs. A device that moves things first waits until cell-sim answers a ping
+  // (requests and replies both get through); throws std::runtime_error if it does not.
   void start(std::chrono::milliseconds wait_for_sim = std::chrono::seconds(30));
   dds::SimClock& clock();
   void publish_capability();

@@ -3,13 +3,20 @@
 // of its own, delivering its events one at a time.
 
 #include <chrono>
+#include <sys/prctl.h>
+
 #include <atomic>
+#include <csignal>
 #include <thread>
 #include <vector>
 
 #include "services/runtime/resource.hpp"
 
 namespace services {
+
+// The process gets SIGTERM when the process that started it ends, however it ends: a cell or
+// a twin never outlives the cellctl (or test) that started it.
+inline void stop_with_parent() { ::prctl(PR_SET_PDEATHSIG, SIGTERM); }
 
 inline void run_until_stopped(const std::vector<fb::Resource*>& resources, const std::atomic<bool>& running) {
   std::vector<std::thread> threads;

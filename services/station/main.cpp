@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   arm.liveliness_lease_s = station.liveliness_lease_s;
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
+  services::stop_with_parent();
   try {
     auto participant = dds::make_participant(station.id, dds);
     fb::Resource station_resource(station.id, 256), arm_resource(arm.id, 256);
@@ -61,7 +62,12 @@ int main(int argc, char** argv) {
     auto& arm_block = arm_resource.add(std::make_unique<fb::ArmBlock>("arm", arm.id, arm_settings));
     // Both are held by one order at a time, for as long as it says it needs them; the arm
     // only by an order that works at its station.
-    const auto hold = [](const fb::Data& call) {
+    // A call may name the station it wants (an order moving to a shorter queue).
+    const auto hold = [&station](const fb::Data& call) {
+      const std::string at = fb::get_or<std::string>(call, "station", "");
+      if (!at.empty() && at != station.id && fb::get<std::string>(call, "operation") == "host") {
+        return fb::Contractor::Estimate{false, "the call is for " + at, 0};
+      }
       return fb::Contractor::Estimate{true, "", fb::get_or<double>(call, "duration", 0)};
     };
     const auto hold_arm = [&station, &arm, hold](const fb::Data& call) {

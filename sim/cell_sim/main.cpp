@@ -16,6 +16,7 @@
 #include "services/dds/service_blocks.hpp"
 #include "sim/cell_sim/world_block.hpp"
 #include "simulationPubSubTypes.h"
+#include "services/node/run.hpp"
 
 namespace {
 // Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   dds::apply_interfaces(settings, all_interfaces);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
+  services::stop_with_parent();
   try {
     auto participant = dds::make_participant("cell-sim", settings);
     fb::Resource resource("cell-sim", 1024);

@@ -90,27 +90,26 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   REQUIRE(commands.wait_for_readers(1, std::chrono::seconds(10)));
 
   REQUIRE(commands.write(give("c1", "SquarePeg")));
-  REQUIRE(seen.wait([&] { return seen.events.size() >= 3; }));
+  REQUIRE(seen.wait([&] { return seen.events.size() >= 2; }));
   CHECK(seen.events[0].command_id() == "c1");
   CHECK(seen.events[0].state() == cell::ACCEPTED);
-  CHECK(seen.events[1].state() == cell::EXECUTING);
-  CHECK(seen.events[2].state() == cell::SUCCEEDED);
+  CHECK(seen.events[1].state() == cell::SUCCEEDED);
   REQUIRE(seen.wait([&] { return stock_of(seen.capabilities.back(), "SquarePeg") == 0; }));
 
   REQUIRE(commands.write(give("c2", "SquarePeg")));
-  REQUIRE(seen.wait([&] { return seen.events.size() >= 6; }));
-  CHECK(seen.events[3].state() == cell::ACCEPTED);
-  CHECK(seen.events[5].command_id() == "c2");
-  CHECK(seen.events[5].state() == cell::ABORTED);
-  CHECK(seen.events[5].reason() == "buffer buffer-1 has no SquarePeg");
+  REQUIRE(seen.wait([&] { return seen.events.size() >= 4; }));
+  CHECK(seen.events[2].state() == cell::ACCEPTED);
+  CHECK(seen.events[3].command_id() == "c2");
+  CHECK(seen.events[3].state() == cell::ABORTED);
+  CHECK(seen.events[3].reason() == "buffer buffer-1 has no SquarePeg");
 
   // The same command again (its sender heard nothing): not carried out twice, its last
   // event comes again.
   REQUIRE(commands.write(give("c2", "SquarePeg")));
-  REQUIRE(seen.wait([&] { return seen.events.size() >= 7; }));
-  CHECK(seen.events[6].command_id() == "c2");
-  CHECK(seen.events[6].state() == cell::ABORTED);
-  CHECK(seen.events[6].reason() == "buffer buffer-1 has no SquarePeg");
+  REQUIRE(seen.wait([&] { return seen.events.size() >= 5; }));
+  CHECK(seen.events[4].command_id() == "c2");
+  CHECK(seen.events[4].state() == cell::ABORTED);
+  CHECK(seen.events[4].reason() == "buffer buffer-1 has no SquarePeg");
 
   CHECK(buffer.stop() == 0);
   REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));

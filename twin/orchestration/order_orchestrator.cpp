@@ -55,6 +55,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       const std::string& id = get<std::string>(d, "resource_id");
       if (state() == "WAITING_CELL") try_begin_virtual();
       if (state() == "QUEUED" && id == station_) on_queue_news(p);
+      if (state() == "QUEUED" && p.kind == "station" && id != station_) consider_moving_to(id);
       if (state() == "HIRING" && id == arm_ && p.reserved_by == settings_.order_id) {
         arm_held_ = true;
         start_physical_when_hired();
@@ -100,18 +101,8 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     transition(in, "AWARDED", in, [this](const Data& d) { on_awarded(d); });
     transition(in, "UNAVAILABLE", in, [this](const Data& d) { fail(get<std::string>(d, "reason")); });
   }
-  transition("QUEUED", "RESOURCE_GONE", "BOOKING", [this](const Data&) {
-    awarded_.erase(station_);
-    emit("FINDING", {{"kind", std::string("rebooked")},
-                     {"message", station_ + " disappeared while the order waited for it; booking another station"},
-                     {"part", std::string()}});
-    book();
-  }, [this](const Data& d) { return get<std::string>(d, "resource_id") == station_; });
-  for (const char* in : {"HIRING", "PHYSICAL"}) {
-    transition(in, "RESOURCE_GONE", in, [this](const Data& d) {
-      const std::string& id = get<std::string>(d, "resource_id");
-      if (awarded_.count(id)) fail(id + " disappeared (its liveliness lease ran out)");
-    });
+  for (const char* in : all_states) {
+    transition(in, "RESOURCE_GONE", in, [this](const Data& d) { on_resource_gone(get<std::string>(d, "resource_id")); });
   }
 
   transition("PHYSICAL", "COMMAND_EVENT", "PHYSICAL", [this](const Data& d) {
@@ -187,14 +178,39 @@ double OrderOrchestrator::physical_estimate() const {
   return length / settings_.arm_speed;
 }
 
-void OrderOrchestrator::book() {
+void OrderOrchestrator::book(const std::string& only) {
   enter("BOOKING");
   ahead_ = -1;
   waiting_since_ = std::chrono::steady_clock::now();
-  status("WAITING", "virtual assembly done; booking a station", 0);
+  status("WAITING", only.empty() ? "virtual assembly done; booking a station" : "booking " + only + ", whose queue is shorter", 0);
   emit("CALL", {{"call_id", settings_.order_id + "/" + kHost}, {"operation", kHost}, {"part_type", std::string()},
-                {"station", std::string()}, {"sources", std::string()}, {"count", std::int64_t(0)},
+                {"station", only}, {"sources", std::string()}, {"count", std::int64_t(0)},
                 {"duration", physical_estimate()}});
+}
+
+// Orders booked at the same moment see the same bids and may crowd one station: an order
+// that waits moves to another station whose queue is shorter by two or more, or that is free.
+void OrderOrchestrator::consider_moving_to(const std::string& station) {
+  const Place& p = places_.at(station);
+  const long load = (p.reserved_by.empty() ? 0 : 1) + static_cast<long>(p.waiting.size());
+  if (ahead_ < 1 || !(load == 0 || load + 1 < ahead_)) return;
+  emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", station_}});
+  awarded_.erase(station_);
+  book(station);
+}
+
+void OrderOrchestrator::on_resource_gone(const std::string& id) {
+  places_.erase(id);
+  if (state() == "QUEUED" && id == station_) {
+    awarded_.erase(station_);
+    emit("FINDING", {{"kind", std::string("rebooked")},
+                     {"message", station_ + " disappeared while the order waited for it; booking another station"},
+                     {"part", std::string()}});
+    return book();
+  }
+  if ((state() == "HIRING" || state() == "PHYSICAL") && awarded_.count(id)) {
+    fail(id + " disappeared (its liveliness lease ran out)");
+  }
 }
 
 void OrderOrchestrator::on_queue_news(const Place& station) {

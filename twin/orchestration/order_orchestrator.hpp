@@ -16,7 +16,8 @@
 //                the best bid wins (the Negotiator block does the contract net)
 //   QUEUED       the station confirmed a place in its queue: the order holds nothing and
 //                waits as long as the queue lasts ("waiting for station-1: 3 orders ahead");
-//                a station that disappears is booked again elsewhere
+//                it moves to another station whose queue became shorter by two or more (or
+//                free); a station that disappears is booked again elsewhere
 //   HIRING       the station is held: calls for its arm, for a buffer per part type (with
 //                the count) and then for a mobile robot for the batch of fetches
 //   PHYSICAL     every part spawned at its buffer's dock; the hired robot's fetches in
@@ -93,8 +94,10 @@ class OrderOrchestrator : public fb::BasicBlock {
 
   // Booking and hiring.
   void try_begin_virtual();
-  void book();
+  void book(const std::string& only = "");  // `only`: call that station alone
   void on_queue_news(const Place& station);
+  void consider_moving_to(const std::string& station);
+  void on_resource_gone(const std::string& id);
   void hire();
   void on_awarded(const fb::Data& award);
   void hire_robot_when_ready();

@@ -29,6 +29,7 @@
 #include "twin/orchestration/order_network.hpp"
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/plan_json.hpp"
+#include "services/node/run.hpp"
 
 namespace {
 
@@ -287,6 +288,7 @@ int main(int argc, char** argv) {
   dds::apply_interfaces(o.dds, all_interfaces);
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
+  services::stop_with_parent();
   try {
     TwinProcess twin(o);
     return twin.run();
