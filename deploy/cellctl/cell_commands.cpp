@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <filesystem>
@@ -74,6 +75,12 @@ class RunningCell {
       if (p->poll() >= 0) return p.get();
     }
     return nullptr;
+  }
+
+  void forget(Process* process) {
+    processes_.erase(std::remove_if(processes_.begin(), processes_.end(),
+                                    [&](const auto& p) { return p.get() == process; }),
+                     processes_.end());
   }
 
   std::vector<std::pair<std::string, long>> peak_rss() const {
@@ -313,6 +320,11 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
     const bool all = report_orders(orders, observer);
     exit_code = all ? 0 : 1;
+    while (Process* p = running.ended()) {  // a cell process that did not last the run is a fault
+      std::cerr << "error: " << p->name() << " ended during the run (exit " << p->poll() << ")\n";
+      running.forget(p);
+      exit_code = 1;
+    }
     if (orders.size() == 1 && orders.front().exit_code == 2) exit_code = 2;  // a bad product description
     const auto rss = running.peak_rss();
     running.stop();

@@ -4,7 +4,9 @@
 // service that uses it; the runtime stays free of DDS.
 //
 //   PublishBlock:   REQ (data) -> writes one sample -> CNF, or ERROR (reason)
-//   SubscribeBlock: a sample arrives -> IND (data); its writers are gone -> GONE (key data)
+//   SubscribeBlock: a sample arrives -> IND (data); its writers are gone -> GONE (key data).
+//                   A mapping that returns no data drops the sample on the listener thread
+//                   (one meant for another resource never takes a place in this queue).
 
 #include <functional>
 #include <iostream>
@@ -74,7 +76,9 @@ class SubscribeBlock : public fb::FunctionBlock {
  private:
   void deliver(const char* input, const T& sample) {
     try {
-      post_to_self(input, to_data_(sample));
+      fb::Data data = to_data_(sample);
+      if (data.empty()) return;
+      post_to_self(input, std::move(data));
     } catch (const std::exception& e) {
       // Nothing to return to on a listener thread: say it loudly; the resource counts it.
       std::cerr << "error: " << name() << " on " << topic_ << ": " << e.what() << '\n';

@@ -62,7 +62,10 @@ int main(int argc, char** argv) {
         }));
     auto& give_events = resource.add(std::make_unique<dds::SubscribeBlock<cell::CommandEvent, cell::CommandEventPubSubType>>(
         "give_events", participant, "cell/command_events", dds::TopicKind::events, [](const cell::CommandEvent& e) {
-          return fb::Data{{"command_id", e.command_id()}, {"state", std::string(dds::state_name(e.state()))},
+          // Only answers to gives (this robot's among them), not the whole cell's traffic.
+          const std::string& id = e.command_id();
+          if (id.size() < 5 || id.compare(id.size() - 5, 5, "/give") != 0) return fb::Data{};
+          return fb::Data{{"command_id", id}, {"state", std::string(dds::state_name(e.state()))},
                           {"reason", e.reason()}};
         }));
     resource.add(std::make_unique<dds::PublishBlock<cell::Command, cell::CommandPubSubType>>(

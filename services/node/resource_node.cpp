@@ -164,8 +164,11 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   // Commands and their life cycle.
   const std::string dev = device.name();
   n.lifecycle = &resource.add(std::make_unique<fb::CommandLifecycle>("lifecycle", n.config.when_busy));
+  const std::string me = n.config.id;
   n.subscribe<cell::Command, cell::CommandPubSubType>("commands", "cell/commands", TopicKind::events,
-                                                     [](const cell::Command& c) { return dds::to_data(c); });
+                                                     [me](const cell::Command& c) {
+                                                       return c.resource_id() == me ? dds::to_data(c) : fb::Data{};
+                                                     });
   resource.connect("commands", "IND", dev, "COMMAND");
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
       "cancels", "cell/cancel_requests", TopicKind::events,
@@ -226,8 +229,12 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     n.publish<cell::SimRequest, cell::SimRequestPubSubType>("sim_requests", "cell/sim/requests",
                                                             [](const fb::Data& d) { return dds::to_sim_request(d); });
     n.sim_requests = &dynamic_cast<Pub<cell::SimRequest, cell::SimRequestPubSubType>&>(resource.block("sim_requests"));
-    n.subscribe<cell::SimReply, cell::SimReplyPubSubType>("sim_replies", "cell/sim/replies", TopicKind::events,
-                                                          [](const cell::SimReply& r) { return dds::to_data(r); });
+    // Only this resource's replies (a device's, or the node's pings).
+    const std::string me = n.config.id;
+    n.subscribe<cell::SimReply, cell::SimReplyPubSubType>(
+        "sim_replies", "cell/sim/replies", TopicKind::events, [me](const cell::SimReply& r) {
+          return r.requester() == me || r.requester() == me + "/node" ? dds::to_data(r) : fb::Data{};
+        });
     resource.connect(dev, "SIM", "sim_requests", "REQ");
     resource.connect("sim_replies", "IND", dev, "SIM_REPLY");
     resource.add(std::make_unique<fb::ActionBlock>("sim_ping", [&n](const fb::Data& reply) {

@@ -2,7 +2,7 @@
 // A resource runs its function blocks from one bounded event queue, one event at a time, so
 // blocks need no locks. Other threads (DDS listeners, timers) post events into it. A full
 // queue is an error, never a silent drop: post() throws EventQueueOverflow, and the count of
-// refused events stays visible.
+// refused events stays visible. Events that blocks emit are never refused.
 
 #include <atomic>
 #include <chrono>
@@ -66,7 +66,10 @@ class Resource {
     Event event;
   };
   void adopt(std::unique_ptr<FunctionBlock> block);
-  void enqueue(FunctionBlock& target, Event event);  // caller holds mutex_
+  // Caller holds mutex_. Only events from outside (post) are refused when the queue is full:
+  // what a block emits is the bounded consequence of an event already taken, and refusing it
+  // would throw out of the resource's own thread and end the process.
+  void enqueue(FunctionBlock& target, Event event, bool from_outside);
   void emitted(FunctionBlock& from, const std::string& output, const Data& data);
 
   std::string name_;

@@ -107,8 +107,8 @@ void Resource::connect(const std::string& from, const std::string& output, const
   connections_.emplace(std::make_pair(&source, output), std::make_pair(&target, input));
 }
 
-void Resource::enqueue(FunctionBlock& target, Event event) {
-  if (queue_.size() >= capacity_) {
+void Resource::enqueue(FunctionBlock& target, Event event, bool from_outside) {
+  if (from_outside && queue_.size() >= capacity_) {
     ++refused_;
     throw EventQueueOverflow("event queue of resource " + name_ + " is full (" + std::to_string(capacity_) +
                              " events): refused " + target.name() + "." + event.name);
@@ -122,7 +122,7 @@ void Resource::post(const std::string& name, const std::string& input, Data data
     if (closed_) return;
     FunctionBlock& target = block(name);
     if (!target.has_input(input)) throw std::logic_error(name + " has no event input " + input);
-    enqueue(target, {input, std::move(data)});
+    enqueue(target, {input, std::move(data)}, true);
   }
   ready_.notify_one();
 }
@@ -130,7 +130,7 @@ void Resource::post(const std::string& name, const std::string& input, Data data
 void Resource::emitted(FunctionBlock& from, const std::string& output, const Data& data) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto [begin, end] = connections_.equal_range({&from, output});
-  for (auto it = begin; it != end; ++it) enqueue(*it->second.first, {it->second.second, data});
+  for (auto it = begin; it != end; ++it) enqueue(*it->second.first, {it->second.second, data}, false);
 }
 
 bool Resource::run_one() {
