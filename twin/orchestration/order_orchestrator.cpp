@@ -134,8 +134,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   });
   transition("PHYSICAL", "TICK", "PHYSICAL", [this](const Data&) { resend_unheard(); });
   transition("CLEANUP", "TICK", "CLEANUP", [this](const Data&) {
-    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) return finish();
-    resend_unheard();
+    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) finish();
   });
 }
 
@@ -477,6 +476,7 @@ void OrderOrchestrator::plan_physical() {
 void OrderOrchestrator::plan_cleanup() {
   enter("CLEANUP");
   waiting_since_ = std::chrono::steady_clock::now();
+  unheard_.clear();  // what was not heard of by now is not wanted any more
   actions_.clear();
   action_running_ = false;
   for (const std::string& body : spawned_) actions_.push_back({Action::sim, sim_.remove(body)});
