@@ -3,6 +3,10 @@
 #include <stdexcept>
 
 namespace dds {
+namespace {
+// A text field of event data, "" when missing.
+std::string text(const fb::Data& d, const char* key) { return fb::get_or<std::string>(d, key, ""); }
+}  // namespace
 
 fb::Numbers to_numbers(const std::vector<cell::Pose>& path) {
   fb::Numbers out;
@@ -58,21 +62,20 @@ const char* state_name(cell::CommandState state) {
 }
 
 cell::CommandEvent to_command_event(const fb::Data& d) {
-  const auto text = [&](const char* key) { return fb::get_or<std::string>(d, key, ""); };
   cell::CommandEvent e;
-  e.command_id(text("command_id"));
-  e.resource_id(text("resource_id"));
-  e.order_id(text("order_id"));
-  e.operation(text("operation"));
-  e.part(text("part"));
-  const std::string state = text("state");
+  e.command_id(text(d, "command_id"));
+  e.resource_id(text(d, "resource_id"));
+  e.order_id(text(d, "order_id"));
+  e.operation(text(d, "operation"));
+  e.part(text(d, "part"));
+  const std::string state = text(d, "state");
   bool known = false;
   for (auto s : {cell::ACCEPTED, cell::EXECUTING, cell::CANCELING, cell::SUCCEEDED, cell::CANCELED, cell::ABORTED}) {
     if (state == state_name(s)) e.state(s), known = true;
   }
   if (!known) throw std::invalid_argument("no command state '" + state + "'");
   e.progress(e.state() == cell::SUCCEEDED ? 1.0 : 0.0);
-  e.reason(text("reason"));
+  e.reason(text(d, "reason"));
   e.sim_time(fb::get_or<double>(d, "sim_time", 0));
   e.distance(fb::get_or<double>(d, "distance", 0));
   e.duration(fb::get_or<double>(d, "duration", 0));
@@ -88,16 +91,15 @@ fb::Data to_data(const cell::Command& c) {
 }
 
 cell::Command to_command(const fb::Data& d) {
-  const auto text = [&](const char* key) { return fb::get_or<std::string>(d, key, ""); };
   cell::Command c;
-  c.command_id(text("command_id"));
-  c.resource_id(text("resource_id"));
-  c.order_id(text("order_id"));
-  c.operation(text("operation"));
-  c.part(text("part"));
-  c.part_type(text("part_type"));
-  c.source(text("source"));
-  c.destination(text("destination"));
+  c.command_id(text(d, "command_id"));
+  c.resource_id(text(d, "resource_id"));
+  c.order_id(text(d, "order_id"));
+  c.operation(text(d, "operation"));
+  c.part(text(d, "part"));
+  c.part_type(text(d, "part_type"));
+  c.source(text(d, "source"));
+  c.destination(text(d, "destination"));
   c.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
   c.size(to_vec3(fb::get_or<fb::Numbers>(d, "size", {0, 0, 0})));
   c.direction(to_vec3(fb::get_or<fb::Numbers>(d, "direction", {0, 0, 0})));
@@ -113,21 +115,20 @@ fb::Data to_data(const cell::SimReply& r) {
 }
 
 cell::SimRequest to_sim_request(const fb::Data& d) {
-  const auto text = [&](const char* key) { return fb::get_or<std::string>(d, key, ""); };
   cell::SimRequest r;
-  r.request_id(text("request_id"));
-  r.requester(text("requester"));
-  r.kind(text("kind"));
-  r.body_id(text("body_id"));
-  r.scene(text("scene"));
+  r.request_id(text(d, "request_id"));
+  r.requester(text(d, "requester"));
+  r.kind(text(d, "kind"));
+  r.body_id(text(d, "body_id"));
+  r.scene(text(d, "scene"));
   r.fixture(fb::get_or<bool>(d, "fixture", false));
-  r.mesh_uri(text("mesh_uri"));
+  r.mesh_uri(text(d, "mesh_uri"));
   r.half_extents(to_vec3(fb::get_or<fb::Numbers>(d, "half_extents", {0, 0, 0})));
   const auto placement = to_path(fb::get_or<fb::Numbers>(d, "placement", {0, 0, 0, 1, 0, 0, 0}));
   if (placement.size() != 1) throw std::invalid_argument("a placement is one pose");
   r.placement(placement.front());
   r.is_static(fb::get_or<bool>(d, "is_static", false));
-  r.carried(fb::split_names(text("carried")));
+  r.carried(fb::split_names(text(d, "carried")));
   r.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
   r.speed(fb::get_or<double>(d, "speed", 0));
   r.angular_speed(fb::get_or<double>(d, "angular_speed", 0));
@@ -174,9 +175,6 @@ cell::SimReply to_sim_reply(const fb::Data& d) {
 }  // namespace dds
 
 namespace dds {
-namespace {
-std::string text(const fb::Data& d, const char* key) { return fb::get_or<std::string>(d, key, ""); }
-}  // namespace
 
 fb::Data to_data(const cell::CallForProposals& c) {
   return {{"call_id", c.call_id()},     {"order_id", c.order_id()}, {"operation", c.operation()},

@@ -51,9 +51,8 @@ int main(int argc, char** argv) {
     auto& robot = resource.add(std::make_unique<fb::MobileRobotBlock>(
         "robot", config.id, fb::Numbers(config.position.begin(), config.position.end()), config.speed));
     const auto estimate = [&robot](const fb::Data& call) {
-      const auto e = robot.estimate(fb::split_names(fb::get_or<std::string>(call, "sources", "")),
-                                    fb::get_or<std::string>(call, "station", ""));
-      return fb::Contractor::Estimate{e.known, e.known ? "" : "no dock known for '" + e.unknown_place + "'", e.duration};
+      return robot.estimate(fb::split_names(fb::get_or<std::string>(call, "sources", "")),
+                            fb::get_or<std::string>(call, "station", ""));
     };
     services::ResourceNode node(resource, participant, config, robot, estimate);
     auto& places = resource.add(std::make_unique<dds::SubscribeBlock<cell::Capability, cell::CapabilityPubSubType>>(

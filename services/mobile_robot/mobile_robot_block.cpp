@@ -90,20 +90,23 @@ void MobileRobotBlock::drive_to(const std::string& place, const std::vector<std:
 }
 
 
-MobileRobotBlock::Estimate MobileRobotBlock::estimate(const std::vector<std::string>& sources,
-                                                      const std::string& destination) const {
-  Estimate e;
+Contractor::Estimate MobileRobotBlock::estimate(const std::vector<std::string>& sources,
+                                                const std::string& destination) const {
+  const auto unknown = [](const std::string& place) {
+    return Contractor::Estimate{false, "no dock known for '" + place + "'", 0};
+  };
+  Contractor::Estimate e;
   const auto distance = [](const Numbers& a, const Numbers& b) { return std::hypot(a[0] - b[0], a[2] - b[2]); };
   Numbers at = work_ends_at_;
-  if (!docks_.count(destination)) return {false, destination, 0};
+  if (!docks_.count(destination)) return unknown(destination);
   const Numbers& to = docks_.at(destination);
   for (const auto& source : sources) {
     const auto it = docks_.find(source);
-    if (it == docks_.end()) return {false, source, 0};
+    if (it == docks_.end()) return unknown(source);
     e.duration += (distance(at, it->second) + distance(it->second, to)) / speed_;
     at = to;
   }
-  e.known = true;
+  e.available = true;
   return e;
 }
 

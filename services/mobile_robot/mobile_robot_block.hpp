@@ -14,6 +14,7 @@
 
 #include <map>
 
+#include "services/blocks/contractor.hpp"
 #include "services/node/device_block.hpp"
 #include "services/node/sim_requests.hpp"
 
@@ -24,12 +25,7 @@ class MobileRobotBlock : public DeviceBlock {
   MobileRobotBlock(std::string name, std::string resource_id, Numbers home, double speed);
 
   // Driving to each source and on to the destination, s; a refusal when a place is unknown.
-  struct Estimate {
-    bool known = false;
-    std::string unknown_place;
-    double duration = 0;
-  };
-  Estimate estimate(const std::vector<std::string>& sources, const std::string& destination) const;
+  Contractor::Estimate estimate(const std::vector<std::string>& sources, const std::string& destination) const;
 
  private:
   void drive_to(const std::string& place, const std::vector<std::string>& carried);

@@ -216,7 +216,10 @@ void OrderOrchestrator::on_queue_news(const Place& station) {
   if (station.reserved_by == settings_.order_id) return hire();
   const auto it = std::find(station.waiting.begin(), station.waiting.end(), settings_.order_id);
   if (it == station.waiting.end()) return;  // not in the queue yet (the award's reply was quicker)
-  const long ahead = 1 + (it - station.waiting.begin());
+  report_place(1 + (it - station.waiting.begin()));
+}
+
+void OrderOrchestrator::report_place(long ahead) {
   if (ahead == ahead_) return;
   ahead_ = ahead;
   status("WAITING", "waiting for " + station_ + ": " + std::to_string(ahead) + (ahead == 1 ? " order" : " orders") +
@@ -253,11 +256,7 @@ void OrderOrchestrator::on_awarded(const Data& d) {
     if (ahead == 0) return hire();
     enter("QUEUED");
     on_queue_news(places_[station_]);
-    if (ahead_ < 0) {
-      ahead_ = ahead;
-      status("WAITING", "waiting for " + station_ + ": " + std::to_string(ahead) + (ahead == 1 ? " order" : " orders") +
-                            " ahead", 0);
-    }
+    if (ahead_ < 0) report_place(ahead);
     return;
   }
   if (what == kArm) {

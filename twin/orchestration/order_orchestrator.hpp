@@ -96,6 +96,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   void try_begin_virtual();
   void book(const std::string& only = "");  // `only`: call that station alone
   void on_queue_news(const Place& station);
+  void report_place(long ahead);  // "waiting for station-1: N orders ahead", when N changed
   void consider_moving_to(const std::string& station);
   void on_resource_gone(const std::string& id);
   void hire();
