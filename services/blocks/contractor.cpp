@@ -1,6 +1,7 @@
 #include "services/blocks/contractor.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace fb {
 
@@ -53,7 +54,12 @@ double Contractor::earliest_start(const std::string& order) const {
 }
 
 void Contractor::propose(const Data& call) {
-  const Estimate e = estimate_(call);
+  // A call from the network is checked before the device is asked.
+  const double hold = get_or<double>(call, "duration", 0);
+  const std::int64_t count = get_or<std::int64_t>(call, "count", 0);
+  const Estimate e = !std::isfinite(hold) || hold < 0 ? Estimate{false, "the call's duration is not a number >= 0", 0}
+                     : count < 0                    ? Estimate{false, "the call's count is negative", 0}
+                                                    : estimate_(call);
   const std::string& id = get<std::string>(call, "call_id");
   if (e.available) {
     Data offered = call;

@@ -1,6 +1,7 @@
 #include "services/blocks/negotiator.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace fb {
@@ -48,8 +49,11 @@ void Negotiator::receive(const Event& e) {
   Call& c = it->second;
   const std::string& resource = get<std::string>(e.data, "resource_id");
   if (e.name == "PROPOSAL") {
-    if (get<bool>(e.data, "available")) {
-      c.bids[resource] = {resource, get<double>(e.data, "earliest_start"), get<double>(e.data, "duration")};
+    const double start = get<double>(e.data, "earliest_start"), duration = get<double>(e.data, "duration");
+    if (get<bool>(e.data, "available") && (!std::isfinite(start) || !std::isfinite(duration) || duration < 0)) {
+      c.refusals[resource] = "its bid was not a finite start and duration >= 0";
+    } else if (get<bool>(e.data, "available")) {
+      c.bids[resource] = {resource, start, duration};
       c.refusals.erase(resource);
     } else {
       c.refusals[resource] = get<std::string>(e.data, "reason");

@@ -2,6 +2,8 @@
 // (a resource's bids, its queue of orders, its work taken on) and the Negotiator (a twin's
 // calls, the choice of the best bid, refusals, a queue place, a call nobody answers).
 
+#include <cmath>
+#include <limits>
 #include <thread>
 
 #include <catch2/catch.hpp>
@@ -187,4 +189,24 @@ TEST_CASE("negotiator: the awarded resource disappears before it confirms: the n
   const auto next = f.send("RESOURCE_GONE", {{"resource_id", std::string("station-1")}});
   REQUIRE(names<fb::Negotiator>(next) == Names{"AWARD"});
   CHECK(fb::get<std::string>(next[0].data, "resource_id") == "station-2");
+}
+
+TEST_CASE("contract net: calls and bids that are not numbers are refused with a reason", "[fb][negotiation]") {
+  fb::BlockTestFixture<fb::Contractor> contractor("contractor", "station-1", std::set<std::string>{"host"}, true,
+                                                  holds(), [] { return 0.0; });
+  for (double bad : {std::nan(""), -1.0, std::numeric_limits<double>::infinity()}) {
+    const auto refusal = contractor.send("CFP", cfp("o1", "host", bad));
+    REQUIRE(names<fb::Contractor>(refusal) == Names{"PROPOSE"});
+    CHECK_FALSE(fb::get<bool>(refusal[0].data, "available"));
+    CHECK(fb::get<std::string>(refusal[0].data, "reason") == "the call's duration is not a number >= 0");
+  }
+  // A NaN bid is never awarded; the good one is.
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", fb::NegotiationSettings{});
+  f.send("CAPABILITY", capability("station-1", "host"));
+  f.send("CAPABILITY", capability("station-2", "host"));
+  f.send("CALL", cfp("o1", "host"));
+  CHECK(f.send("PROPOSAL", proposal("o1/host", "station-1", std::nan(""), 1)).empty());
+  const auto award = f.send("PROPOSAL", proposal("o1/host", "station-2", 50, 10));
+  REQUIRE(names<fb::Negotiator>(award) == Names{"AWARD"});
+  CHECK(fb::get<std::string>(award[0].data, "resource_id") == "station-2");
 }
