@@ -158,7 +158,7 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   std::set<std::string> ids;
   for (const auto& order : orders) ids.insert(order.id);
   observer.on_status([ids](const cell::OrderStatus& s) {
-    if (ids.count(s.order_id())) print_progress(s);
+    if (ids.count(s.order_id().to_string())) print_progress(s);
   });
   for (auto& order : orders) {
     std::vector<std::string> argv{executable_dir() + "/twin", "--domain", std::to_string(cell.domain), "--order", order.id,
@@ -199,7 +199,7 @@ bool report_orders(const std::vector<Order>& orders, CellObserver& observer) {
   for (const auto& order : orders) {
     const auto it = statuses.find(order.id);
     std::string result = order.exit_code == 0 ? "assembled" : "failed (exit " + std::to_string(order.exit_code) + ")";
-    if (order.exit_code != 0 && it != statuses.end() && !it->second.message().empty()) result += ": " + it->second.message();
+    if (order.exit_code != 0 && it != statuses.end() && it->second.message().size() > 0) result += ": " + it->second.message().to_string();
     table.add_row({order.id, fs::path(order.product).filename().string(), result, fixed(order.sim_start, 1),
                    fixed(order.sim_end, 1), std::to_string(order.peak_rss_kb / 1024)});
     first = std::min(first, order.sim_start);
@@ -266,13 +266,16 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     CellObserver observer(cell.domain, cell.localhost_only);
     observer.wait_for_resources(cell.resource_ids(), 2s);
     std::this_thread::sleep_for(300ms);  // orders and resources outside the file
-    TextTable resources({"resource", "kind", "state", "work", "queued", "reserved by", "waiting", "stock"});
+    TextTable resources({"resource", "kind", "state", "work", "queued", "reserved by", "waiting", "stock", "refused"});
     for (const auto& [id, r] : observer.resources()) {
       std::string stock, waiting;
-      for (const auto& s : r.capability.stock()) stock += s.part_type() + "=" + std::to_string(s.count()) + " ";
-      for (const auto& w : r.capability.waiting()) waiting += (waiting.empty() ? "" : " ") + w;
-      resources.add_row({id, r.capability.kind(), r.alive ? "alive" : "gone", r.capability.busy() ? "busy" : "idle",
-                         std::to_string(r.capability.queued_commands()), r.capability.reserved_by(), waiting, stock});
+      for (const auto& s : r.capability.stock()) stock += s.part_type().to_string() + "=" + std::to_string(s.count()) + " ";
+      for (const auto& w : r.capability.waiting()) waiting += (waiting.empty() ? "" : " ") + w.to_string();
+      const cell::Capability& c = r.capability;
+      const std::string refused =
+          c.refused_commands() == 0 ? "" : std::to_string(c.refused_commands()) + ", last: " + c.last_refusal().to_string();
+      resources.add_row({id, c.kind().to_string(), r.alive ? "alive" : "gone", c.busy() ? "busy" : "idle",
+                         std::to_string(c.queued_commands()), c.reserved_by().to_string(), waiting, stock, refused});
     }
     std::cout << "Cell on domain " << cell.domain << ": " << observer.resources().size() << " resources\n\n";
     resources.print(std::cout);

@@ -35,11 +35,11 @@ CellObserver::CellObserver(int domain, bool localhost_only) : impl_(std::make_un
   };
   impl_->capabilities = std::make_unique<dds::Reader<cell::Capability, cell::CapabilityPubSubType>>(
       impl_->participant, "cell/capabilities", dds::TopicKind::state,
-      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id()] = {c, true}; }); },
-      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id()] = {c, false}; }); });
+      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id().to_string()] = {c, true}; }); },
+      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id().to_string()] = {c, false}; }); });
   impl_->statuses = std::make_unique<dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType>>(
       impl_->participant, "cell/orders/status", dds::TopicKind::state, [this, changed](const cell::OrderStatus& s) {
-        changed([&] { orders_[s.order_id()] = s; });
+        changed([&] { orders_[s.order_id().to_string()] = s; });
         std::function<void(const cell::OrderStatus&)> callback;
         {
           std::lock_guard<std::mutex> lock(mutex_);
@@ -51,14 +51,18 @@ CellObserver::CellObserver(int domain, bool localhost_only) : impl_(std::make_un
       impl_->participant, "cell/command_events", dds::TopicKind::events, [this](const cell::CommandEvent& e) {
         std::lock_guard<std::mutex> lock(mutex_);
         if (!events_.is_open()) return;
-        nlohmann::json line{{"t", e.sim_time()},      {"resource", e.resource_id()}, {"event", dds::state_name(e.state())},
-                            {"operation", e.operation()}, {"part", e.part()},      {"order", e.order_id()},
-                            {"command", e.command_id()}};
+        nlohmann::json line{{"t", e.sim_time()},
+                            {"resource", e.resource_id().to_string()},
+                            {"event", dds::state_name(e.state())},
+                            {"operation", e.operation().to_string()},
+                            {"part", e.part().to_string()},
+                            {"order", e.order_id().to_string()},
+                            {"command", e.command_id().to_string()}};
         if (e.state() == cell::SUCCEEDED && e.distance() > 0) {
           line["distance"] = e.distance();
           line["duration"] = e.duration();
         }
-        if (!e.reason().empty()) line["reason"] = e.reason();
+        if (e.reason().size() > 0) line["reason"] = e.reason().to_string();
         events_ << line.dump() << '\n';
         ++logged_;
         if (e.state() == cell::SUCCEEDED && e.operation() == "fetch") {

@@ -15,6 +15,7 @@ std::vector<cell::Pose> to_path(const fb::Numbers& numbers);  // throws std::inv
 fb::Numbers to_numbers(const cell::Vec3& v);
 cell::Vec3 to_vec3(const fb::Numbers& numbers);  // throws std::invalid_argument unless three numbers
 cell::Vec3 vec3(double x, double y, double z);
+std::string names(const cell::Ids& ids);  // comma-separated (fb::join_names)
 
 }  // namespace dds
 
@@ -25,7 +26,9 @@ cell::Vec3 vec3(double x, double y, double z);
 
 namespace dds {
 
-// Every field, by its IDL name; path, size and direction as numbers.
+// Every field, by its IDL name; path, size and direction as numbers. Towards DDS, a text
+// longer than its IDL bound, or a path longer than MAX_WAYPOINTS, throws std::length_error
+// (the bounded types would cut it short).
 // "accepted", "executing", ..., as event data and the event log name them.
 const char* state_name(cell::CommandState state);
 fb::Data to_data(const cell::Command& command);

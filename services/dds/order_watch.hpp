@@ -14,7 +14,7 @@ using OrderStatusSubscriber = SubscribeBlock<cell::OrderStatus, cell::OrderStatu
 inline OrderStatusSubscriber& watch_orders(fb::Resource& resource, const ParticipantPtr& participant) {
   auto& orders = resource.add(std::make_unique<OrderStatusSubscriber>(
       "orders", participant, "cell/orders/status", TopicKind::state, [](const cell::OrderStatus& s) {
-        return fb::Data{{"order_id", s.order_id()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
+        return fb::Data{{"order_id", s.order_id().to_string()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
       }));
   resource.add(std::make_unique<fb::OrderWatch>());
   resource.connect("orders", "IND", "order_watch", "STATUS");

@@ -5,6 +5,8 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 
+constexpr int kMaxQueuedEvents = 4096;
+
 template <class Qos>
 void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
   qos.reliability().kind = RELIABLE_RELIABILITY_QOS;
@@ -14,6 +16,10 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
   qos.resource_limits().max_samples_per_instance = 0;
   qos.resource_limits().max_samples = 0;
   qos.data_sharing().off();
+  // Every type is bounded (idl/common.idl): payload buffers of the type's largest size, and
+  // a sample larger than that is refused by Fast DDS on arrival, never reallocated for.
+  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_MEMORY_MODE;
+  qos.resource_limits().allocated_samples = 16;
   if (kind == TopicKind::state) {
     qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = KEEP_LAST_HISTORY_QOS;
@@ -24,6 +30,9 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
   } else {
     qos.durability().kind = VOLATILE_DURABILITY_QOS;
     qos.history().kind = KEEP_ALL_HISTORY_QOS;
+    // Readers take every sample as it comes; a reader this far behind is under a flood, and
+    // a reliable writer then waits (its own write times out): the flood slows its sender.
+    qos.resource_limits().max_samples = kMaxQueuedEvents;
   }
 }
 

@@ -57,15 +57,15 @@ int main(int argc, char** argv) {
     services::ResourceNode node(resource, participant, config, robot, estimate);
     auto& places = resource.add(std::make_unique<dds::SubscribeBlock<cell::Capability, cell::CapabilityPubSubType>>(
         "places", participant, "cell/capabilities", dds::TopicKind::state, [](const cell::Capability& c) {
-          return fb::Data{{"resource_id", c.resource_id()}, {"dock", dds::to_numbers(c.dock())}};
+          return fb::Data{{"resource_id", c.resource_id().to_string()}, {"dock", dds::to_numbers(c.dock())}};
         }));
     auto& give_events = resource.add(std::make_unique<dds::SubscribeBlock<cell::CommandEvent, cell::CommandEventPubSubType>>(
         "give_events", participant, "cell/command_events", dds::TopicKind::events, [](const cell::CommandEvent& e) {
           // Only answers to gives (this robot's among them), not the whole cell's traffic.
-          const std::string& id = e.command_id();
+          const std::string id = e.command_id().to_string();
           if (id.size() < 5 || id.compare(id.size() - 5, 5, "/give") != 0) return fb::Data{};
           return fb::Data{{"command_id", id}, {"state", std::string(dds::state_name(e.state()))},
-                          {"reason", e.reason()}};
+                          {"reason", e.reason().to_string()}};
         }));
     resource.add(std::make_unique<dds::PublishBlock<cell::Command, cell::CommandPubSubType>>(
         "gives", participant, "cell/commands", dds::TopicKind::events,

@@ -99,14 +99,15 @@ struct ResourceNode::Impl {
     c.kind(config.kind);
     std::set<std::string> operations = device.operations();
     operations.insert(config.offers.begin(), config.offers.end());
-    c.operations(std::vector<std::string>(operations.begin(), operations.end()));
+    c.operations(cell::Ids(operations.begin(), operations.end()));
     c.position(dds::vec3(config.position[0], config.position[1], config.position[2]));
     c.dock(dds::vec3(config.dock[0], config.dock[1], config.dock[2]));
     c.reach(config.reach);
     c.speed(config.speed);
     c.angular_speed(config.angular_speed);
     c.reserved_by(contractor->reserved_by());
-    c.waiting(contractor->waiting());
+    const std::vector<std::string> waiting = contractor->waiting();
+    c.waiting(cell::Ids(waiting.begin(), waiting.end()));
     c.queued_commands(static_cast<int32_t>(lifecycle->queued()));
     c.busy(busy);
     if (describe) describe(c);
@@ -172,7 +173,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.connect("commands", "IND", dev, "COMMAND");
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
       "cancels", "cell/cancel_requests", TopicKind::events,
-      [](const cell::CancelRequest& c) { return fb::Data{{"command_id", c.command_id()}}; });
+      [](const cell::CancelRequest& c) { return fb::Data{{"command_id", c.command_id().to_string()}}; });
   resource.connect("cancels", "IND", "lifecycle", "CANCEL");
   resource.connect(dev, "ACCEPT", "lifecycle", "COMMAND");
   resource.connect("lifecycle", "START", dev, "START");

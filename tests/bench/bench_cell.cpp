@@ -86,7 +86,7 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
                                 const std::string& answers_topic, const std::string& resource, int rounds) {
   Answers answers;
   EventReader reader(participant, answers_topic, dds::TopicKind::events, [&](const cell::CommandEvent& e) {
-    if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id());
+    if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id().to_string());
   });
   CommandWriter writer(participant, topic, dds::TopicKind::events);
   if (!writer.wait_for_readers(1, 20s)) throw std::runtime_error("nobody reads " + topic);
@@ -100,7 +100,7 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
     c.part_type("Part");
     const auto start = Clock::now();
     writer.write(c);
-    if (!answers.wait(c.command_id())) throw std::runtime_error("no answer to " + c.command_id());
+    if (!answers.wait(c.command_id().to_string())) throw std::runtime_error("no answer to " + c.command_id().to_string());
     if (i >= 0) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
   }
   return us;
@@ -121,7 +121,7 @@ void twin_start(int domain, int rounds) {
       [&](const cell::OrderStatus& s) {
         {
           std::lock_guard<std::mutex> lock(mutex);
-          seen[s.order_id()] = s;
+          seen[s.order_id().to_string()] = s;
         }
         changed.notify_all();
       },

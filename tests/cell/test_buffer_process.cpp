@@ -57,7 +57,7 @@ std::unique_ptr<CapabilityReader> watch_capabilities(const dds::ParticipantPtr& 
   return std::make_unique<CapabilityReader>(
       participant, "cell/capabilities", dds::TopicKind::state,
       [&](const cell::Capability& c) { seen.add([&] { seen.capabilities.push_back(c); }); },
-      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id()); }); }, qos);
+      [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id().to_string()); }); }, qos);
 }
 
 cell::Command give(const std::string& id, const std::string& part) {

@@ -26,7 +26,7 @@ cell::CommandEvent to_event(const fb::Data& d) {
 }
 
 fb::Data from_event(const cell::CommandEvent& e) {
-  return {{"command_id", e.command_id()}, {"done", e.state() == cell::SUCCEEDED}, {"t", e.sim_time()}};
+  return {{"command_id", e.command_id().to_string()}, {"done", e.state() == cell::SUCCEEDED}, {"t", e.sim_time()}};
 }
 
 // Runs the resource until the recorder holds `count` events or 10 s pass.
@@ -81,7 +81,7 @@ TEST_CASE("state topics: a late reader sees the last state, and a dead writer is
   fb::Resource resource("r", 64);
   auto& sub = resource.add(std::make_unique<CapabilitySubscriber>(
       "capabilities", twin, "cell/capabilities", dds::TopicKind::state, [](const cell::Capability& c) {
-        return fb::Data{{"resource_id", c.resource_id()},
+        return fb::Data{{"resource_id", c.resource_id().to_string()},
                         {"stock", c.stock().empty() ? std::int64_t{0} : std::int64_t{c.stock()[0].count()}}};
       }));
   auto& recorder = resource.add(std::make_unique<fb::EventRecorder>(sub));

@@ -177,15 +177,15 @@ class TwinProcess {
     subscribe<cell::CommandEvent, cell::CommandEventPubSubType>(
         r, "command_events", "cell/command_events", TopicKind::events, [this](const cell::CommandEvent& e) {
           clock_.observe(e.sim_time());
-          if (e.order_id() != options_.order) return fb::Data{};  // another order's
+          if (e.order_id().to_string() != options_.order) return fb::Data{};  // another order's
           if (options_.verbose) std::cout << "  event " << e.command_id() << " " << dds::state_name(e.state()) << " " << e.reason() << std::endl;
-          return fb::Data{{"command_id", e.command_id()}, {"order_id", e.order_id()},
-                          {"resource_id", e.resource_id()}, {"state", std::string(dds::state_name(e.state()))},
-                          {"reason", e.reason()}};
+          return fb::Data{{"command_id", e.command_id().to_string()}, {"order_id", e.order_id().to_string()},
+                          {"resource_id", e.resource_id().to_string()},
+                          {"state", std::string(dds::state_name(e.state()))}, {"reason", e.reason().to_string()}};
         }, {{"orchestrator", "COMMAND_EVENT"}});
     subscribe<cell::SimReply, cell::SimReplyPubSubType>(
         r, "sim_replies", "cell/sim/replies", TopicKind::events, [this](const cell::SimReply& s) {
-          if (s.requester() != options_.order) return fb::Data{};  // another requester's
+          if (s.requester().to_string() != options_.order) return fb::Data{};  // another requester's
           clock_.observe(s.end_time());
           if (options_.verbose) std::cout << "  sim reply " << s.request_id() << " " << s.ok() << " " << s.error() << std::endl;
           return dds::to_data(s);
