@@ -1,6 +1,8 @@
 #include "deploy/cellctl/cell_config.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
@@ -116,6 +118,34 @@ bool overlap(const StationConfig& a, const StationConfig& b) {
   return true;
 }
 
+// The layout's box (tables, docks, homes, buffers) with a margin, unless the file says.
+void read_bounds(const std::filesystem::path& file, const YAML::Node& root, CellConfig& c) {
+  const double inf = std::numeric_limits<double>::infinity();
+  c.bounds_min = {inf, inf, inf};
+  c.bounds_max = {-inf, -inf, -inf};
+  const auto add = [&](const Point& p, const Point& half) {
+    for (int i = 0; i < 3; ++i) {
+      c.bounds_min[i] = std::min(c.bounds_min[i], p[i] - half[i] - kBoundsMargin);
+      c.bounds_max[i] = std::max(c.bounds_max[i], p[i] + half[i] + kBoundsMargin);
+    }
+  };
+  for (const auto& s : c.stations) {
+    add(s.position, s.table);
+    add(s.dock, {});
+  }
+  for (const auto& r : c.robots) add(r.home, {});
+  for (const auto& b : c.buffers) add(b.position, {});
+  const YAML::Node bounds = root["bounds"];
+  if (!bounds) return;
+  if (!bounds.IsMap()) throw ConfigError(where(file, bounds) + ": bounds take 'min' and 'max'");
+  known_keys(file, bounds, {"min", "max"});
+  read_point(file, bounds, "min", c.bounds_min);
+  read_point(file, bounds, "max", c.bounds_max);
+  for (int i = 0; i < 3; ++i) {
+    if (!(c.bounds_min[i] < c.bounds_max[i])) throw ConfigError(where(file, bounds) + ": each minimum must be below its maximum");
+  }
+}
+
 }  // namespace
 
 CellConfig read_cell_config(const std::filesystem::path& file) {
@@ -132,7 +162,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers"});
+              "mobile_robots", "buffers", "bounds"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -154,6 +184,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     c.buffers.push_back(buffer);
     buffer_nodes.push_back(b);
   }
+  read_bounds(file, root, c);
   std::vector<std::pair<std::string, YAML::Node>> named;  // every resource id, where it stands
   for (std::size_t i = 0; i < c.stations.size(); ++i) {
     const YAML::Node node = i < station_nodes.size() ? station_nodes[i] : root;
@@ -179,8 +210,15 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
 std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesystem::path& bin) {
   const std::string domain = std::to_string(c.domain), lease = std::to_string(c.liveliness_lease);
   std::vector<ProcessSpec> out;
+  const auto add_bounds = [&c](std::vector<std::string>& argv) {
+    argv.push_back("--cell-bounds");
+    for (const Point& p : {c.bounds_min, c.bounds_max}) {
+      for (double v : p) argv.push_back(std::to_string(v));
+    }
+  };
   out.push_back({"cell-sim", {(bin / "cell-sim").string(), "--domain", domain, "--real-time-factor",
                               std::to_string(c.real_time_factor)}});
+  add_bounds(out.back().argv);
   for (const auto& st : c.stations) {
     ProcessSpec station{st.id, {(bin / "station").string(), "--domain", domain, "--id", st.id, "--arm-id", st.arm,
                                 "--arm-speed", std::to_string(st.arm_speed), "--arm-angular-speed",
@@ -188,6 +226,7 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     add_point(station.argv, "--position", st.position);
     add_point(station.argv, "--dock", st.dock);
     add_point(station.argv, "--table", st.table);
+    add_bounds(station.argv);
     out.push_back(station);
   }
   for (const auto& r : c.robots) {

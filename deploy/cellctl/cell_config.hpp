@@ -11,6 +11,7 @@
 namespace cellctl {
 
 using Point = std::array<double, 3>;
+constexpr double kBoundsMargin = 3.0;  // m around the layout, when the file gives no bounds
 
 struct StationConfig {
   std::string id = "station-1", arm = "arm-1";
@@ -39,6 +40,9 @@ struct CellConfig {
   std::vector<StationConfig> stations{StationConfig{}};
   std::vector<RobotConfig> robots{RobotConfig{}};
   std::vector<BufferConfig> buffers;
+  // The box every commanded position must lie in (cell-sim and the arms refuse others):
+  // `bounds: {min: [x, y, z], max: [x, y, z]}`, or the layout's box with a margin.
+  Point bounds_min{}, bounds_max{};
 
   std::vector<std::string> resource_ids() const;
 };

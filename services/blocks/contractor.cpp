@@ -35,8 +35,16 @@ std::vector<std::string> Contractor::waiting() const {
   return out;
 }
 
-bool Contractor::serves(const std::string& order) const {
-  return exclusive_ ? !order.empty() && holder_.order == order : work_.count(order) > 0;
+std::string Contractor::refusal(const std::string& order, const std::string& award) const {
+  if (award.empty()) return "the command names no award of " + resource_id_;
+  const std::string of_order = " of order " + (order.empty() ? std::string("''") : order);
+  if (!exclusive_) {
+    const auto it = work_.find(order);
+    return it != work_.end() && it->second.count(award) ? "" : resource_id_ + " has no award " + award + of_order;
+  }
+  if (holder_.order.empty()) return resource_id_ + " is not reserved" + of_order;
+  if (holder_.order != order) return resource_id_ + " is reserved by " + holder_.order;
+  return holder_.calls.count(award) ? "" : resource_id_ + " has no award " + award + of_order;
 }
 
 // Exclusive: after the holder's expected end and the expected holds of those waiting.
@@ -71,33 +79,41 @@ void Contractor::propose(const Data& call) {
                    {"duration", e.duration}});
 }
 
-void Contractor::reply(const std::string& call_id, bool confirmed, const std::string& reason, long ahead) {
-  emit("REPLY", {{"call_id", call_id}, {"confirmed", confirmed}, {"reason", reason}, {"ahead", std::int64_t(ahead)}});
+void Contractor::reply(const std::string& call_id, const std::string& order, bool confirmed, const std::string& reason,
+                       long ahead) {
+  emit("REPLY", {{"call_id", call_id}, {"order_id", order}, {"confirmed", confirmed}, {"reason", reason},
+                 {"ahead", std::int64_t(ahead)}});
 }
 
 void Contractor::award(const Data& d) {
   const std::string& call = get<std::string>(d, "call_id");
   const std::string& order = get<std::string>(d, "order_id");
   const auto bid = bids_.find(call);
-  if (bid == bids_.end()) return reply(call, false, resource_id_ + " made no offer for call " + call, 0);
+  if (bid == bids_.end()) return reply(call, order, false, resource_id_ + " made no offer for call " + call, 0);
+  if (get<std::string>(bid->second, "order_id") != order) {
+    return reply(call, order, false, "call " + call + " was made by order " + get<std::string>(bid->second, "order_id"), 0);
+  }
   Data awarded = std::move(bid->second);
   bids_.erase(bid);
   awarded["order_id"] = order;
   const double duration = get<double>(awarded, "duration");
   const double now = now_();
   if (!exclusive_) {
-    ++work_[order];
+    work_[order].insert(call);
     busy_until_ = std::max(now, busy_until_) + duration;
-    reply(call, true, "", 0);
+    reply(call, order, true, "", 0);
     return emit("AWARDED", std::move(awarded));
   }
   if (holder_.order.empty() || holder_.order == order) {
-    holder_ = {order, now + duration, duration};
-    reply(call, true, "", 0);
+    std::set<std::string> calls = holder_.order == order ? holder_.calls : std::set<std::string>{};
+    calls.insert(call);
+    holder_ = {order, now + duration, duration, std::move(calls)};
+    reply(call, order, true, "", 0);
   } else {
     auto it = std::find_if(waiting_.begin(), waiting_.end(), [&](const Hold& h) { return h.order == order; });
-    if (it == waiting_.end()) it = waiting_.insert(waiting_.end(), {order, 0, duration});
-    reply(call, true, "", 1 + (it - waiting_.begin()));
+    if (it == waiting_.end()) it = waiting_.insert(waiting_.end(), {order, 0, duration, {}});
+    it->calls.insert(call);
+    reply(call, order, true, "", 1 + (it - waiting_.begin()));
   }
   emit("RESERVED", {{"order_id", holder_.order}});
   emit("AWARDED", std::move(awarded));

@@ -15,7 +15,7 @@
 //
 //   inputs                                         outputs
 //   CFP     (call_id, order_id, operation, ...)    PROPOSE  (call_id, available, reason, earliest_start, duration)
-//   AWARD   (call_id, resource_id, order_id)       REPLY    (call_id, confirmed, reason, ahead)
+//   AWARD   (call_id, resource_id, order_id)       REPLY    (call_id, order_id, confirmed, reason, ahead)
 //   RELEASE (order_id, resource_id)                RESERVED (order_id): the holder changed, or the queue
 //   ORDER_ENDED (order_id)                         AWARDED  (the call's data, duration): work taken on
 //   IDLE: the device has no work left (a shared resource's queue estimate starts again from now)
@@ -49,20 +49,23 @@ class Contractor : public BasicBlock {
 
   const std::string& reserved_by() const { return holder_.order; }
   std::vector<std::string> waiting() const;
-  // Whether the order holds this resource (exclusive) or has work taken on by it (shared).
-  bool serves(const std::string& order) const;
+  // Authorization of a command: "" when `award` is a call this resource confirmed for
+  // `order` and the order holds the resource now (exclusive) or has work taken on by it
+  // (shared); otherwise why not ("arm-1 is reserved by ok1").
+  std::string refusal(const std::string& order, const std::string& award) const;
 
  private:
   struct Hold {
     std::string order;
     double until = 0;  // expected end, sim s
     double duration = 0;
+    std::set<std::string> calls;  // the awards it holds this resource by
   };
   double earliest_start(const std::string& order) const;
   void award(const Data& award);
   void end(const std::string& order);
   void propose(const Data& call);
-  void reply(const std::string& call_id, bool confirmed, const std::string& reason, long ahead);
+  void reply(const std::string& call_id, const std::string& order, bool confirmed, const std::string& reason, long ahead);
 
   std::string resource_id_;
   std::set<std::string> offers_;
@@ -72,7 +75,7 @@ class Contractor : public BasicBlock {
   Hold holder_;                                // exclusive: who holds it
   std::deque<Hold> waiting_;                   // exclusive: who waits, in turn
   std::map<std::string, Data> bids_;           // call id -> the call offered for, with the bid's duration
-  std::map<std::string, int> work_;            // shared: order -> awards taken on
+  std::map<std::string, std::set<std::string>> work_;  // shared: order -> awards taken on
   double busy_until_ = 0;                      // shared: the end of the work taken on
 };
 

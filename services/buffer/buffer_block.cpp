@@ -41,6 +41,12 @@ int BufferBlock::free(const std::string& part_type) const {
   return n;
 }
 
+void BufferBlock::check(const Data& command, SampleCheck& c) const {
+  if (get<std::string>(command, "operation") == "give" && get_or<std::string>(command, "part", "").empty()) {
+    c.text("part_type", true);
+  }
+}
+
 void BufferBlock::order_ended(const std::string& order) { kept_.erase(order); }
 
 }  // namespace fb

@@ -24,6 +24,7 @@ class BufferBlock : public DeviceBlock {
 
  private:
   void order_ended(const std::string& order) override;
+  void check(const Data& command, SampleCheck& check) const override;
 
   std::map<std::string, int> stock_;
   std::map<std::string, std::map<std::string, int>> kept_;  // order -> type -> parts kept for it

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "services/blocks/sample_checks.hpp"
 #include "services/dds/participant.hpp"
 
 namespace dds {
@@ -12,6 +13,24 @@ namespace dds {
 inline void add_dds_options(CLI::App& app, ParticipantSettings& settings, bool& all_interfaces) {
   app.add_option("--domain", settings.domain_id, "DDS domain id")->required()->check(CLI::Range(0, 232));
   app.add_flag("--all-interfaces", all_interfaces, "Use every network interface, not only loopback");
+}
+
+// --cell-bounds XMIN YMIN ZMIN XMAX YMAX ZMAX: the box every commanded position lies in.
+// `values` must outlive parsing; apply it with apply_bounds() afterwards.
+inline void add_bounds_option(CLI::App& app, std::vector<double>& values) {
+  app.add_option("--cell-bounds", values, "The cell's box, m: XMIN YMIN ZMIN XMAX YMAX ZMAX (default: 50 m around 0)")
+      ->expected(6);
+}
+
+inline fb::CellBounds apply_bounds(const std::vector<double>& values) {
+  fb::CellBounds b;
+  if (values.size() != 6) return b;
+  for (int i = 0; i < 3; ++i) {
+    if (!(values[i] < values[i + 3])) throw CLI::ValidationError("--cell-bounds", "each minimum must be below its maximum");
+    b.min[i] = values[i];
+    b.max[i] = values[i + 3];
+  }
+  return b;
 }
 
 inline void apply_interfaces(ParticipantSettings& settings, bool all_interfaces) {

@@ -30,6 +30,10 @@ namespace dds {
 
 namespace fdds = eprosima::fastdds::dds;
 
+// Each resource reads its commands from a topic of its own: no process receives (and keeps
+// in its reader) another resource's commands.
+inline std::string command_topic(const std::string& resource_id) { return "cell/commands/" + resource_id; }
+
 // The topic of that name on the participant, created (and its type registered) if needed.
 template <class PubSubType>
 fdds::Topic* topic_on(fdds::DomainParticipant& participant, const std::string& name) {

@@ -7,9 +7,14 @@
 //   SubscribeBlock: a sample arrives -> IND (data); its writers are gone -> GONE (key data).
 //                   A mapping that returns no data drops the sample on the listener thread
 //                   (one meant for another resource never takes a place in this queue).
+//                   A sample the resource's queue has no room for goes to `on_refused`
+//                   (on the listener thread), which answers its sender.
+//   RoutedPublishBlock: REQ (data) -> writes one sample on the topic `route` names for the
+//                   data (a resource's own command topic), a writer per topic, made on first use.
 
 #include <functional>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "services/dds/endpoints.hpp"
@@ -35,10 +40,11 @@ class PublishBlock : public fb::FunctionBlock {
 
   void receive(const fb::Event& event) override {
     if (event.name != "REQ") return;
-    if (writer_->write(to_sample_(event.data))) {
-      emit("CNF");
-    } else {
+    try {
+      if (writer_->write(to_sample_(event.data))) return emit("CNF");
       emit("ERROR", {{"reason", std::string("DDS write failed on ") + name()}});
+    } catch (const std::exception& e) {  // data that does not fit the type (a text too long)
+      emit("ERROR", {{"reason", name() + ": " + e.what()}});
     }
   }
 
@@ -73,12 +79,23 @@ class SubscribeBlock : public fb::FunctionBlock {
     if (event.name == "LOST") emit("GONE", event.data);
   }
 
+  // Set before start().
+  void on_refused(std::function<void(const T&, const std::string& why)> refused) { on_refused_ = std::move(refused); }
+
  private:
   void deliver(const char* input, const T& sample) {
     try {
       fb::Data data = to_data_(sample);
       if (data.empty()) return;
       post_to_self(input, std::move(data));
+    } catch (const fb::EventQueueOverflow& e) {
+      if (on_refused_) {
+        try {
+          on_refused_(sample, "queue full");
+        } catch (const std::exception& answer) {
+          std::cerr << "error: " << name() << " on " << topic_ << ": " << answer.what() << '\n';
+        }
+      }
     } catch (const std::exception& e) {
       // Nothing to return to on a listener thread: say it loudly; the resource counts it.
       std::cerr << "error: " << name() << " on " << topic_ << ": " << e.what() << '\n';
@@ -89,7 +106,47 @@ class SubscribeBlock : public fb::FunctionBlock {
   std::string topic_;
   TopicKind kind_;
   ToData to_data_;
+  std::function<void(const T&, const std::string&)> on_refused_;
   std::unique_ptr<Reader<T, PubSubType>> reader_;
+};
+
+template <class T, class PubSubType>
+class RoutedPublishBlock : public fb::FunctionBlock {
+ public:
+  using ToSample = std::function<T(const fb::Data&)>;
+  using Route = std::function<std::string(const fb::Data&)>;  // the topic for the data
+
+  RoutedPublishBlock(std::string name, ParticipantPtr participant, Route route, ToSample to_sample)
+      : FunctionBlock(std::move(name)), participant_(std::move(participant)), route_(std::move(route)),
+        to_sample_(std::move(to_sample)) {
+    declare_input("REQ");
+    declare_output("CNF");
+    declare_output("ERROR", {"reason"});
+  }
+
+  void receive(const fb::Event& event) override {
+    if (event.name != "REQ") return;
+    try {
+      const std::string topic = route_(event.data);
+      auto& writer = writers_[topic];
+      if (!writer) {
+        writer = std::make_unique<Writer<T, PubSubType>>(participant_, topic, TopicKind::events);
+        // The reader is there (its resource was hired): wait for the match, which takes
+        // milliseconds between participants that know each other, so the first sample is not lost.
+        writer->wait_for_readers(1, std::chrono::seconds(1));
+      }
+      if (writer->write(to_sample_(event.data))) return emit("CNF");
+      emit("ERROR", {{"reason", std::string("DDS write failed on ") + topic}});
+    } catch (const std::exception& e) {
+      emit("ERROR", {{"reason", std::string(e.what())}});
+    }
+  }
+
+ private:
+  ParticipantPtr participant_;
+  Route route_;
+  ToSample to_sample_;
+  std::map<std::string, std::unique_ptr<Writer<T, PubSubType>>> writers_;
 };
 
 }  // namespace dds

@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
           return fb::Data{{"command_id", id}, {"state", std::string(dds::state_name(e.state()))},
                           {"reason", e.reason().to_string()}};
         }));
-    resource.add(std::make_unique<dds::PublishBlock<cell::Command, cell::CommandPubSubType>>(
-        "gives", participant, "cell/commands", dds::TopicKind::events,
+    resource.add(std::make_unique<dds::RoutedPublishBlock<cell::Command, cell::CommandPubSubType>>(
+        "gives", participant, [](const fb::Data& d) { return dds::command_topic(fb::get<std::string>(d, "resource_id")); },
         [](const fb::Data& d) { return dds::to_command(d); }));
     resource.connect("places", "IND", "robot", "PLACE");
     resource.connect("give_events", "IND", "robot", "GIVE_EVENT");

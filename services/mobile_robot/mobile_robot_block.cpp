@@ -54,6 +54,7 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   };
   transition("READY", "START", "TO_SOURCE", [this](const Data& d) {
     fetch_ = d;
+    sim_.act_for(get_or<std::string>(d, "order_id", ""));
     distance_ = moving_ = 0;
     drive_to(get<std::string>(d, "source"), {});
   }, knows_places);
@@ -67,6 +68,7 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
     emit("GIVE", {{"command_id", give_id_},
                   {"resource_id", fetch_.at("source")},
                   {"order_id", fetch_.at("order_id")},
+                  {"award", get_or<std::string>(fetch_, "source_award", "")},
                   {"operation", std::string("give")},
                   {"part", fetch_.at("part")},
                   {"part_type", fetch_.at("part_type")},
@@ -78,10 +80,15 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   }, give_answer("succeeded"));
   transition("WAIT_GIVE", "GIVE_EVENT", "READY", [this](const Data& d) {
     emit("FAIL", {{"reason", get<std::string>(d, "reason")}, {"distance", distance_}, {"duration", moving_}});
-  }, give_answer("aborted"));
+  }, [give_answer](const Data& d) { return give_answer("aborted")(d) || give_answer("rejected")(d); });
   transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, account](const Data& reply) { emit("DONE", account(reply)); },
              arrived);
   transition("TO_DESTINATION", "SIM_REPLY", "READY", fail, answered);
+}
+
+void MobileRobotBlock::check(const Data& command, SampleCheck& c) const {
+  if (get<std::string>(command, "operation") != "fetch") return;
+  c.text("source", true).text("destination", true).text("part_type", true).text("source_award", true);
 }
 
 void MobileRobotBlock::drive_to(const std::string& place, const std::vector<std::string>& carried) {

@@ -28,6 +28,7 @@ class MobileRobotBlock : public DeviceBlock {
   Contractor::Estimate estimate(const std::vector<std::string>& sources, const std::string& destination) const;
 
  private:
+  void check(const Data& command, SampleCheck& check) const override;
   void drive_to(const std::string& place, const std::vector<std::string>& carried);
   std::string body() const { return resource_id() + "/base"; }
 

@@ -15,6 +15,17 @@ DeviceBlock::DeviceBlock(std::string name, std::string resource_id, std::set<std
   declare_output("DONE");
   declare_output("FAIL", {"reason"});
   declare_output("REPEAT", {"command_id", "state"});
+  declare_output("REFUSE", {"command_id", "reason", "order_id", "operation", "part"});
+}
+
+std::string DeviceBlock::problem_with(const Data& command) const {
+  SampleCheck c(command, bounds_);
+  c.text("command_id", true).text("resource_id", true).text("order_id").text("operation", true).text("part");
+  c.text("part_type").text("source").text("destination").text("award").text("source_award");
+  c.poses("path", 0).vector("size").vector("direction").at_least("sim_time", 0);
+  if (c.ok()) check(command, c);
+  if (!c.ok()) return c.error();
+  return authorize_ ? authorize_(command) : "";
 }
 
 void DeviceBlock::ended(const std::string& command_id, const Data& last_event) {
@@ -43,6 +54,14 @@ void DeviceBlock::receive(const Event& event) {
     const std::string& id = get<std::string>(event.data, "command_id");
     if (commands_.count(id)) return;
     if (const auto done = ended_.find(id); done != ended_.end()) return emit("REPEAT", done->second);
+    if (const std::string problem = problem_with(event.data); !problem.empty()) {
+      ++refused_;
+      last_refusal_ = get_or<std::string>(event.data, "order_id", "") + " " + id + ": " + problem;
+      return emit("REFUSE", {{"command_id", id}, {"reason", problem},
+                             {"order_id", get_or<std::string>(event.data, "order_id", "")},
+                             {"operation", get_or<std::string>(event.data, "operation", "")},
+                             {"part", get_or<std::string>(event.data, "part", "")}});
+    }
     commands_[id] = event.data;
     emit("ACCEPT", {{"command_id", id}});
     return;

@@ -8,6 +8,13 @@
 //   inputs                                  outputs
 //   COMMAND (command_id, resource_id,       ACCEPT   (command_id)    to the life cycle
 //            operation, ...)                PROGRESS, DONE, FAIL     to the life cycle
+//                                           REFUSE (command_id, reason, order_id, operation, part):
+//                                           never accepted, see below
+//   A command is checked before it is accepted: its fields (finite numbers, unit quaternions,
+//   positions inside the cell's bounds, texts and paths within limits, and what the device
+//   itself needs: an arm's grip pad above 0 in size), then whether its order may command the
+//   resource (`authorize`: it holds the award the command names). A command that fails is
+//   REFUSEd with the reason, never queued or started.
 //   A command that comes again (its sender heard nothing of it: a DDS match that was not
 //   complete yet) is not carried out twice: while it is under way it is ignored (its events
 //   will come); once it has ended, REPEAT gives its last event again.
@@ -21,6 +28,9 @@
 #include <map>
 #include <set>
 
+#include <functional>
+
+#include "services/blocks/sample_checks.hpp"
 #include "services/runtime/basic_block.hpp"
 
 namespace fb {
@@ -30,7 +40,14 @@ class DeviceBlock : public BasicBlock {
   DeviceBlock(std::string name, std::string resource_id, std::set<std::string> operations,
               std::string initial_state = "READY");
 
+  // "" when the command's order may command this resource, otherwise why not.
+  using Authorize = std::function<std::string(const Data& command)>;
+
   const std::string& resource_id() const { return resource_id_; }
+  void set_bounds(const CellBounds& bounds) { bounds_ = bounds; }
+  void authorize_with(Authorize authorize) { authorize_ = std::move(authorize); }
+  std::size_t refused() const { return refused_; }
+  const std::string& last_refusal() const { return last_refusal_; }
   const std::set<std::string>& operations() const { return operations_; }
   // The command as it came (empty when unknown); ended() once its last event is out, with
   // that event's data (state, reason, ...), which REPEAT gives again if the command comes again.
@@ -42,6 +59,9 @@ class DeviceBlock : public BasicBlock {
  protected:
   // An order ended (done, failed, its twin gone): a device frees what it kept for it.
   virtual void order_ended(const std::string& /*order*/) {}
+  // Adds a device's own checks of a command to the common ones.
+  virtual void check(const Data& /*command*/, SampleCheck& /*check*/) const {}
+  const CellBounds& bounds() const { return bounds_; }
 
  private:
   std::string resource_id_;
@@ -50,6 +70,12 @@ class DeviceBlock : public BasicBlock {
   std::map<std::string, Data> ended_;    // command id -> its command and last event, the newest few
   std::deque<std::string> ended_order_;  // oldest first
   std::set<std::string> ended_orders_;
+  CellBounds bounds_;
+  Authorize authorize_;
+  std::size_t refused_ = 0;
+  std::string last_refusal_;
+
+  std::string problem_with(const Data& command) const;
 };
 
 }  // namespace fb

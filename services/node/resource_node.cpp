@@ -1,5 +1,7 @@
 #include "services/node/resource_node.hpp"
 
+#include <atomic>
+#include <mutex>
 #include <thread>
 
 #include "capabilitiesPubSubTypes.h"
@@ -23,10 +25,12 @@ using Pub = dds::PublishBlock<T, P>;
 
 const std::pair<const char*, cell::CommandState> kLifecycleOutputs[] = {
     {"ACCEPTED", cell::ACCEPTED}, {"EXECUTING", cell::EXECUTING}, {"SUCCEEDED", cell::SUCCEEDED},
-    {"ABORTED", cell::ABORTED},   {"REJECTED", cell::ABORTED},    {"CANCELING", cell::CANCELING},
+    {"ABORTED", cell::ABORTED},   {"REJECTED", cell::REJECTED},   {"CANCELING", cell::CANCELING},
     {"CANCELED", cell::CANCELED}};
 
-bool is_final(cell::CommandState s) { return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED; }
+bool is_final(cell::CommandState s) {
+  return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED || s == cell::REJECTED;
+}
 
 // Publishes the capability once the events queued before are through: a command's events go
 // out first (a commander waits for them, not for the capability), and a command done at
@@ -70,6 +74,11 @@ struct ResourceNode::Impl {
   std::function<void(cell::Capability&)> describe;
   dds::SimClock clock;
   std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
+  // Answers to commands the resource's queue had no room for, written on the listener thread.
+  std::unique_ptr<dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>> overflow_answers;
+  std::atomic<std::size_t> overflowed{0};
+  std::mutex refusal_mutex;
+  std::string last_overflow;
   std::vector<std::function<void()>> starters;
   Pub<cell::SimRequest, cell::SimRequestPubSubType>* sim_requests = nullptr;
   fb::CommandLifecycle* lifecycle = nullptr;
@@ -110,13 +119,21 @@ struct ResourceNode::Impl {
     c.waiting(cell::Ids(waiting.begin(), waiting.end()));
     c.queued_commands(static_cast<int32_t>(lifecycle->queued()));
     c.busy(busy);
+    c.refused_commands(static_cast<int32_t>(device.refused() + overflowed));
+    {
+      std::lock_guard<std::mutex> lock(refusal_mutex);
+      const std::string& last = last_overflow.empty() ? device.last_refusal() : last_overflow;
+      c.last_refusal(last.substr(0, cell::Text::max_size - 1));
+      last_overflow.clear();
+    }
     if (describe) describe(c);
     capabilities->write(c);
   }
 
   cell::CommandEvent event_of(cell::CommandState state, const fb::Data& d) {
     const std::string& id = fb::get<std::string>(d, "command_id");
-    const fb::Data& command = device.command(id);
+    const fb::Data& known = device.command(id);
+    const fb::Data& command = known.empty() ? d : known;  // a refused command was never the device's
     cell::CommandEvent e;
     e.command_id(id);
     e.resource_id(config.id);
@@ -131,7 +148,7 @@ struct ResourceNode::Impl {
     clock.observe(fb::get_or<double>(command, "sim_time", 0));
     if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
     e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
-    if (is_final(state)) {
+    if (is_final(state) && !known.empty()) {
       fb::Data last = d;
       last["state"] = std::string(dds::state_name(state));
       last["sim_time"] = e.sim_time();
@@ -166,10 +183,30 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   const std::string dev = device.name();
   n.lifecycle = &resource.add(std::make_unique<fb::CommandLifecycle>("lifecycle", n.config.when_busy));
   const std::string me = n.config.id;
-  n.subscribe<cell::Command, cell::CommandPubSubType>("commands", "cell/commands", TopicKind::events,
-                                                     [me](const cell::Command& c) {
-                                                       return c.resource_id() == me ? dds::to_data(c) : fb::Data{};
-                                                     });
+  device.set_bounds(n.config.bounds);
+  device.authorize_with([&n](const fb::Data& c) {
+    return n.contractor->refusal(fb::get_or<std::string>(c, "order_id", ""), fb::get_or<std::string>(c, "award", ""));
+  });
+  auto& commands = n.subscribe<cell::Command, cell::CommandPubSubType>(
+      "commands", dds::command_topic(me), TopicKind::events,
+      [me](const cell::Command& c) { return c.resource_id().to_string() == me ? dds::to_data(c) : fb::Data{}; });
+  n.overflow_answers = std::make_unique<dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>>(
+      participant, "cell/command_events", TopicKind::events);
+  commands.on_refused([&n](const cell::Command& c, const std::string& why) {
+    cell::CommandEvent e;
+    e.command_id(c.command_id());
+    e.resource_id(n.config.id);
+    e.order_id(c.order_id());
+    e.operation(c.operation());
+    e.part(c.part());
+    e.state(cell::REJECTED);
+    e.reason(n.config.id + ": " + why);
+    e.sim_time(n.clock.now());
+    n.overflow_answers->write(e);
+    ++n.overflowed;
+    std::lock_guard<std::mutex> lock(n.refusal_mutex);
+    n.last_overflow = c.order_id().to_string() + " " + c.command_id().to_string() + ": " + why;
+  });
   resource.connect("commands", "IND", dev, "COMMAND");
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
       "cancels", "cell/cancel_requests", TopicKind::events,
@@ -190,6 +227,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     resource.connect("lifecycle", output, name, "REQ");
     resource.connect(name, "CNF", "capability_refresh", "CHECK");
   }
+  resource.connect(dev, "REFUSE", "event_REJECTED", "REQ");
 
   // The contract net.
   n.contractor = &resource.add(std::make_unique<fb::Contractor>("contractor", n.config.id, n.config.offers, n.config.exclusive,
@@ -224,6 +262,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.add(std::make_unique<fb::ActionBlock>("capability", [this](const fb::Data&) { publish_capability(); }));
   resource.connect("contractor", "RESERVED", "capability", "REQ");
   if (device.has_output("CAPABILITY")) resource.connect(dev, "CAPABILITY", "capability_refresh", "CHANGED");
+  resource.connect(dev, "REFUSE", "capability_refresh", "CHANGED");
 
   // cell-sim, for devices that move things.
   if (device.has_output("SIM")) {

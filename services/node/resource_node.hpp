@@ -5,7 +5,9 @@
 // the end of orders) through a Contractor, the capability with its liveliness lease, and
 // cell-sim requests and replies when the device moves things.
 //
-//   cell/commands --> device.COMMAND --> lifecycle --> cell/command_events
+//   cell/commands/<id> --> device.COMMAND (checked, authorised by the contractor's awards)
+//     --> lifecycle --> cell/command_events; a refused command, or one the queue has no
+//     room for, is answered REJECTED with the reason, and counted in the capability
 //   cell/negotiation/* and cell/orders/status --> contractor --> proposals, replies, capability
 //   (the holder and the queue of waiting orders), device.AWARDED
 //   device.SIM --> cell/sim/requests;  cell/sim/replies --> device.SIM_REPLY
@@ -42,6 +44,7 @@ struct NodeConfig {
   std::set<std::string> offers;  // operations it bids for in the contract net ("host", "fetch", ...)
   bool exclusive = true;     // held by one order at a time; others wait in its queue
   double liveliness_lease_s = 5.0;
+  fb::CellBounds bounds;     // commands' positions must lie inside
   fb::CommandLifecycle::WhenBusy when_busy = fb::CommandLifecycle::WhenBusy::reject;
 };
 

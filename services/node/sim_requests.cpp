@@ -4,7 +4,7 @@ namespace fb {
 
 Data SimRequests::request(const std::string& kind, const std::string& body) {
   last_ = requester_ + "/sim/" + std::to_string(++count_);
-  return {{"request_id", last_}, {"requester", requester_}, {"kind", kind}, {"body_id", body}};
+  return {{"request_id", last_}, {"requester", requester_}, {"order_id", order_}, {"kind", kind}, {"body_id", body}};
 }
 
 Data SimRequests::spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents,

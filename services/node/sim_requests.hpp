@@ -13,6 +13,11 @@ class SimRequests {
  public:
   explicit SimRequests(std::string requester) : requester_(std::move(requester)) {}
 
+  // The order the next requests are made for (a hired resource moving its parts); "" for the
+  // requester's own bodies. cell-sim lets a resource change an order's bodies only while the
+  // order has hired it.
+  void act_for(const std::string& order) { order_ = order; }
+
   // `scene`: where the body lives ("" the physical cell, else a virtual scene).
   Data spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents, bool is_static,
              const std::string& mesh_uri = "", const std::string& scene = "");
@@ -32,6 +37,7 @@ class SimRequests {
   Data request(const std::string& kind, const std::string& body);
   std::string requester_;
   std::string last_;
+  std::string order_;
   std::size_t count_ = 0;
 };
 

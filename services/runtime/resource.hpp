@@ -58,6 +58,8 @@ class Resource {
   bool wait_and_run_one(std::chrono::milliseconds timeout);
 
   std::size_t refused() const { return refused_; }
+  // Events whose block threw: the exception is caught, said on stderr and counted here.
+  std::size_t failed() const { return failed_; }
 
  private:
   friend class FunctionBlock;
@@ -81,6 +83,7 @@ class Resource {
   std::deque<Delivery> queue_;
   bool closed_ = false;
   std::atomic<std::size_t> refused_{0};
+  std::atomic<std::size_t> failed_{0};
 };
 
 }  // namespace fb

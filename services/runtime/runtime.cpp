@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <iostream>
 
 #include "services/runtime/basic_block.hpp"
 #include "services/runtime/resource.hpp"
@@ -141,7 +142,14 @@ bool Resource::run_one() {
     next = std::move(queue_.front());
     queue_.pop_front();
   }
-  next.block->receive(next.event);
+  try {
+    next.block->receive(next.event);
+  } catch (const std::exception& e) {
+    // A block's bug or a sample no check foresaw: the event fails alone, the resource and
+    // its thread go on, and the failure is counted and said.
+    ++failed_;
+    std::cerr << "error: " << name_ << ": " << next.block->name() << "." << next.event.name << ": " << e.what() << '\n';
+  }
   return true;
 }
 

@@ -26,6 +26,7 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
   }, op("grip"));
   for (const char* motion : {"translate", "rotate"}) {
     transition("READY", "START", "MOVING", [this](const Data& d) {
+      sim_.act_for(get_or<std::string>(d, "order_id", ""));
       std::vector<std::string> carried{carriage()};
       if (!held_.empty()) carried.push_back(held_);
       awaited_ = 1;
@@ -41,6 +42,7 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
     transition("READY", "START", "WAITING", [this, is_static](const Data& d) {
       error_.clear();
       awaited_ = 1;
+      sim_.act_for(get_or<std::string>(d, "order_id", ""));
       request(sim_.set_static(get<std::string>(d, "part"), is_static));
     }, op(joining));
   }
@@ -66,10 +68,25 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
   }, mine);
 }
 
+// A grip is one pad pose with a size above 0 and a push direction; a motion, a path.
+void ArmBlock::check(const Data& command, SampleCheck& c) const {
+  const std::string& operation = get<std::string>(command, "operation");
+  if (operation == "grip") {
+    c.poses("path", 1, 1).vector("size", true).vector("direction");
+    const Numbers& push = get_or<Numbers>(command, "direction", {});
+    c.require(push.size() != 3 || push[0] != 0 || push[1] != 0 || push[2] != 0, "direction: (0, 0, 0) is no direction");
+  } else if (operation == "translate" || operation == "rotate") {
+    c.poses("path", 1).text("part", true);
+  } else if (operation == "connect" || operation == "disconnect") {
+    c.text("part", true);
+  }
+}
+
 void ArmBlock::request(Data data) { emit("SIM", std::move(data)); }
 
 void ArmBlock::grip(const Data& d) {
   error_.clear();
+  sim_.act_for("");  // the gripper is the arm's own
   const Numbers& pose = get<Numbers>(d, "path");
   const Carriage carriage_body = carriage_behind(pose, get<Numbers>(d, "size"), get<Numbers>(d, "direction"), settings_.gripper);
   awaited_ = 2;

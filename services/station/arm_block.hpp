@@ -30,6 +30,7 @@ class ArmBlock : public DeviceBlock {
   const std::string& held() const { return held_; }
 
  private:
+  void check(const Data& command, SampleCheck& check) const override;
   void grip(const Data& command);
   std::string pad() const { return resource_id() + "/pad"; }
   std::string carriage() const { return resource_id() + "/carriage"; }

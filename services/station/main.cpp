@@ -34,7 +34,9 @@ int main(int argc, char** argv) {
   std::array<double, 3> table{1.0, 0.025, 1.0};
   fb::ArmSettings arm_settings;
   bool all_interfaces = false;
+  std::vector<double> bounds;
   dds::add_dds_options(app, dds, all_interfaces);
+  dds::add_bounds_option(app, bounds);
   app.add_option("--id", station.id, "Resource id of the station");
   app.add_option("--arm-id", arm.id, "Resource id of its arm");
   app.add_option("--position", station.position, "The assembly point on the table's top: x y z, m");
@@ -54,6 +56,7 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, stop);
   services::stop_with_parent();
   try {
+    arm.bounds = station.bounds = dds::apply_bounds(bounds);
     auto participant = dds::make_participant(station.id, dds);
     fb::Resource station_resource(station.id, 256), arm_resource(arm.id, 256);
     auto& station_block = station_resource.add(std::make_unique<fb::StationBlock>(

@@ -15,6 +15,7 @@
 #include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "sim/cell_sim/world_block.hpp"
+#include "negotiationPubSubTypes.h"
 #include "simulationPubSubTypes.h"
 #include "services/node/run.hpp"
 
@@ -30,7 +31,9 @@ int main(int argc, char** argv) {
   double factor = 1.0;
   bool verbose = false;
   bool all_interfaces = false;
+  std::vector<double> bounds;
   dds::add_dds_options(app, settings, all_interfaces);
+  dds::add_bounds_option(app, bounds);
   app.add_option("--real-time-factor", factor, "Sim seconds per wall second")->check(CLI::PositiveNumber);
   app.add_flag("--verbose", verbose, "Print every request and reply");
   CLI11_PARSE(app, argc, argv);
@@ -41,7 +44,7 @@ int main(int argc, char** argv) {
   try {
     auto participant = dds::make_participant("cell-sim", settings);
     fb::Resource resource("cell-sim", 1024);
-    resource.add(std::make_unique<sim::WorldBlock>("world", factor));
+    resource.add(std::make_unique<sim::WorldBlock>("world", factor, dds::apply_bounds(bounds)));
     auto& requests = resource.add(std::make_unique<dds::SubscribeBlock<cell::SimRequest, cell::SimRequestPubSubType>>(
         "requests", participant, "cell/sim/requests", dds::TopicKind::events,
         [verbose](const cell::SimRequest& r) {
@@ -62,12 +65,20 @@ int main(int argc, char** argv) {
           c.real_time_factor(fb::get<double>(d, "real_time_factor"));
           return c;
         }));
+    // Who hired whom: a resource may move an order's parts while the order has hired it.
+    auto& hires = resource.add(std::make_unique<dds::SubscribeBlock<cell::AwardReply, cell::AwardReplyPubSubType>>(
+        "hires", participant, "cell/negotiation/replies", dds::TopicKind::events, [](const cell::AwardReply& r) {
+          if (!r.confirmed()) return fb::Data{};
+          return fb::Data{{"resource_id", r.resource_id().to_string()}, {"order_id", r.order_id().to_string()}};
+        }));
+    resource.connect("hires", "IND", "world", "HIRED");
     auto& orders = dds::watch_orders(resource, participant);
     resource.connect("order_watch", "ENDED", "world", "ORDER_ENDED");
     resource.connect("requests", "IND", "world", "REQUEST");
     resource.connect("world", "REPLY", "replies", "REQ");
     resource.connect("world", "CLOCK", "clock", "REQ");
     requests.start();
+    hires.start();
     orders.start();
     std::cout << "cell-sim ready on domain " << settings.domain_id << ", real-time factor " << factor << std::endl;
     while (running) {

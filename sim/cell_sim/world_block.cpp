@@ -21,12 +21,13 @@ std::vector<Pose> poses(const fb::Numbers& n) {
 
 }  // namespace
 
-WorldBlock::WorldBlock(std::string name, double real_time_factor, double clock_period_s)
-    : FunctionBlock(std::move(name)), factor_(real_time_factor), clock_period_(clock_period_s) {
+WorldBlock::WorldBlock(std::string name, double real_time_factor, fb::CellBounds bounds, double clock_period_s)
+    : FunctionBlock(std::move(name)), factor_(real_time_factor), clock_period_(clock_period_s), policy_(bounds) {
   if (real_time_factor <= 0) throw std::invalid_argument("the real-time factor must be above 0");
   declare_input("REQUEST", {"request_id", "requester", "kind", "body_id"});
   declare_input("TICK");
   declare_input("ORDER_ENDED", {"order_id"});
+  declare_input("HIRED", {"resource_id", "order_id"});
   declare_output("REPLY", {"request_id", "requester", "ok", "error", "collided", "start_time", "end_time"});
   declare_output("CLOCK", {"sim_time", "real_time_factor"});
 }
@@ -38,11 +39,12 @@ double WorldBlock::now() const {
 void WorldBlock::receive(const fb::Event& event) {
   if (event.name == "REQUEST") handle(event.data);
   if (event.name == "ORDER_ENDED") {
-    const std::string& order = fb::get<std::string>(event.data, "order_id");
-    for (auto it = owner_.begin(); it != owner_.end();) {
-      if (it->second == order && world_.pose(it->first)) world_.remove(it->first);
-      it = it->second == order ? owner_.erase(it) : std::next(it);
+    for (const std::string& body : policy_.order_ended(fb::get<std::string>(event.data, "order_id"))) {
+      if (world_.pose(body)) world_.remove(body);
     }
+  }
+  if (event.name == "HIRED") {
+    policy_.hired(fb::get<std::string>(event.data, "resource_id"), fb::get<std::string>(event.data, "order_id"));
   }
   publish_due();
 }
@@ -53,26 +55,27 @@ void WorldBlock::handle(const fb::Data& d) {
                  {"start_time", start}, {"end_time", start}};
   double due = start;
   try {
+    if (const std::string problem = policy_.problem_with(d, world_); !problem.empty()) throw SimError(problem);
     const std::string& kind = fb::get<std::string>(d, "kind");
     const std::string& id = fb::get<std::string>(d, "body_id");
     if (kind == "spawn") {
       const fb::Numbers& h = fb::get<fb::Numbers>(d, "half_extents");
-      world_.spawn({id, fb::get<std::string>(d, "mesh_uri"), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
-                    pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get<bool>(d, "is_static"),
+      world_.spawn({id, fb::get_or<std::string>(d, "mesh_uri", ""), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
+                    pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get_or<bool>(d, "is_static", false),
                     fb::get_or<std::string>(d, "scene", ""), fb::get_or<bool>(d, "fixture", false)});
-      owner_[id] = fb::get<std::string>(d, "requester");
+      policy_.spawned(id, fb::get<std::string>(d, "requester"));
     } else if (kind == "remove") {
       world_.remove(id);
-      owner_.erase(id);
+      policy_.removed(id);
     } else if (kind == "set_static" || kind == "set_movable") {
       world_.set_static(id, kind == "set_static");
     } else if (kind == "ping") {
       // Answered, and nothing else: a requester learns that its requests and cell-sim's
       // replies both reach it (DDS matches each endpoint pair on its own).
     } else if (kind == "move") {
-      const MoveResult r = world_.move({id, fb::split_names(fb::get<std::string>(d, "carried")),
+      const MoveResult r = world_.move({id, fb::split_names(fb::get_or<std::string>(d, "carried", "")),
                                         poses(fb::get<fb::Numbers>(d, "path")), fb::get<double>(d, "speed"),
-                                        fb::get<double>(d, "angular_speed")});
+                                        fb::get_or<double>(d, "angular_speed", 0)});
       // A physical move is answered when the sim clock reaches its end. A virtual one is a
       // check, not work of the cell: answered at once, and it takes no sim time.
       if (world_.scene_of(id).empty()) due = start + r.duration;

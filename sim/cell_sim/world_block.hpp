@@ -10,18 +10,23 @@
 //   TICK                            CLOCK (sim_time, real_time_factor), every clock_period
 //   ORDER_ENDED (order_id): the bodies that order spawned leave the world (a twin that died
 //   leaves nothing behind for the next order)
+//   HIRED (resource_id, order_id): the resource confirmed an award to the order, so it may
+//   move the order's parts (RequestPolicy)
+// A request that is malformed or not allowed is answered ok = false with the reason, and
+// changes nothing.
 
 #include <chrono>
 #include <map>
 
 #include "services/runtime/function_block.hpp"
+#include "sim/cell_sim/request_policy.hpp"
 #include "sim/world/sim_world.hpp"
 
 namespace sim {
 
 class WorldBlock : public fb::FunctionBlock {
  public:
-  WorldBlock(std::string name, double real_time_factor, double clock_period_s = 0.05);
+  WorldBlock(std::string name, double real_time_factor, fb::CellBounds bounds = {}, double clock_period_s = 0.05);
 
   double now() const;  // sim s
   const SimWorld& world() const { return world_; }
@@ -37,7 +42,7 @@ class WorldBlock : public fb::FunctionBlock {
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_clock_{};
   std::multimap<double, fb::Data> pending_;  // replies by the sim time they are due
-  std::map<std::string, std::string> owner_;  // body -> the requester that spawned it
+  RequestPolicy policy_;
 };
 
 }  // namespace sim

@@ -147,6 +147,11 @@ std::string SimWorld::scene_of(const std::string& id) const {
   return it == bodies_.end() ? std::string() : it->second.spec.scene;
 }
 
+bool SimWorld::is_fixture(const std::string& id) const {
+  const auto it = bodies_.find(id);
+  return it != bodies_.end() && it->second.spec.fixture;
+}
+
 bool SimWorld::is_static(const std::string& id) const {
   const auto it = bodies_.find(id);
   return it != bodies_.end() && it->second.spec.is_static;

@@ -69,6 +69,7 @@ class SimWorld {
   // The scene a body lives in ("" the physical cell, or when there is no such body).
   std::string scene_of(const std::string& id) const;
   bool is_static(const std::string& id) const;
+  bool is_fixture(const std::string& id) const;
   std::size_t size() const { return bodies_.size(); }
   std::size_t scenes() const { return scenes_.size(); }  // the physical cell and virtual ones with bodies
 

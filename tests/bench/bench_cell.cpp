@@ -24,6 +24,7 @@
 #include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/hire.hpp"
 
 namespace {
 
@@ -82,8 +83,10 @@ int echo(int domain) {
 }
 
 // Sends `rounds` commands on `topic`, each after the answer to the one before.
+// `award`: what the commands name (a resource obeys only the order that hired it).
 std::vector<double> round_trips(const dds::ParticipantPtr& participant, const std::string& topic,
-                                const std::string& answers_topic, const std::string& resource, int rounds) {
+                                const std::string& answers_topic, const std::string& resource, int rounds,
+                                const std::string& award = "") {
   Answers answers;
   EventReader reader(participant, answers_topic, dds::TopicKind::events, [&](const cell::CommandEvent& e) {
     if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id().to_string());
@@ -96,6 +99,8 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
     cell::Command c;
     c.command_id(resource + "-" + std::to_string(i + 100));
     c.resource_id(resource);
+    c.order_id("bench");
+    c.award(award);
     c.operation("give");
     c.part_type("Part");
     const auto start = Clock::now();
@@ -157,6 +162,15 @@ void twin_start(int domain, int rounds) {
             << rounds - planned.size() << " starts never got there within 10 s" << std::endl;
 }
 
+// Gives from the buffer "bench-buffer", hired first as a twin hires it.
+std::vector<double> buffer_round_trips(const dds::ParticipantPtr& participant, int rounds) {
+  std::string why;
+  const std::string award = test::hire(participant, "bench-buffer", "bench", "give", {"", "Part", rounds + 20}, &why);
+  if (award.empty()) throw std::runtime_error("cannot hire bench-buffer: " + why);
+  return round_trips(participant, dds::command_topic("bench-buffer"), "cell/command_events", "bench-buffer", rounds,
+                     award);
+}
+
 // The round trips while a cell assembles 10 orders on the same host (the bench's echo and
 // buffer on a domain of their own, the cell on another).
 void under_load(const char* self, int domain, int rounds) {
@@ -176,8 +190,7 @@ void under_load(const char* self, int domain, int rounds) {
   {
     test::ChildProcess buffer({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(domain), "--stock",
                                "Part=1000000"});
-    report("while 10 orders run: command to SUCCEEDED, buffer process",
-           round_trips(participant, "cell/commands", "cell/command_events", "bench-buffer", rounds));
+    report("while 10 orders run: command to SUCCEEDED, buffer process", buffer_round_trips(participant, rounds));
     buffer.stop();
   }
   const int code = cell.wait_for_exit(std::chrono::minutes(5));
@@ -205,8 +218,7 @@ int main(int argc, char** argv) {
     {
       test::ChildProcess buffer({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(domain), "--stock",
                                  "Part=1000000"});
-      report("command to SUCCEEDED, buffer process", round_trips(participant, "cell/commands", "cell/command_events",
-                                                                 "bench-buffer", rounds));
+      report("command to SUCCEEDED, buffer process", buffer_round_trips(participant, rounds));
       buffer.stop();
     }
     twin_start(domain + 1, launches);

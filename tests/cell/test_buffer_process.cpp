@@ -12,6 +12,7 @@
 #include "commandsPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/hire.hpp"
 
 namespace {
 
@@ -60,10 +61,12 @@ std::unique_ptr<CapabilityReader> watch_capabilities(const dds::ParticipantPtr& 
       [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id().to_string()); }); }, qos);
 }
 
-cell::Command give(const std::string& id, const std::string& part) {
+cell::Command give(const std::string& id, const std::string& part, const std::string& award) {
   cell::Command c;
   c.command_id(id);
   c.resource_id("buffer-1");
+  c.order_id("o1");
+  c.award(award);
   c.operation("give");
   c.part(part);
   return c;
@@ -81,35 +84,40 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
       participant, "cell/command_events", dds::TopicKind::events,
       [&](const cell::CommandEvent& e) { seen.add([&] { seen.events.push_back(e); }); });
-  dds::Writer<cell::Command, cell::CommandPubSubType> commands(participant, "cell/commands", dds::TopicKind::events);
+  dds::Writer<cell::Command, cell::CommandPubSubType> commands(participant, dds::command_topic("buffer-1"),
+                                                               dds::TopicKind::events);
 
   REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
   CHECK(seen.capabilities.back().resource_id() == "buffer-1");
   CHECK(seen.capabilities.back().kind() == "buffer");
   CHECK(stock_of(seen.capabilities.back(), "SquarePeg") == 1);
   REQUIRE(commands.wait_for_readers(1, std::chrono::seconds(10)));
+  std::string why;
+  const std::string award = test::hire(participant, "buffer-1", "o1", "give", {"", "SquarePeg", 1}, &why);
+  INFO(why);
+  REQUIRE(award == "o1/give/buffer-1");
 
-  REQUIRE(commands.write(give("c1", "SquarePeg")));
+  REQUIRE(commands.write(give("c1", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 2; }));
   CHECK(seen.events[0].command_id() == "c1");
   CHECK(seen.events[0].state() == cell::ACCEPTED);
   CHECK(seen.events[1].state() == cell::SUCCEEDED);
   REQUIRE(seen.wait([&] { return stock_of(seen.capabilities.back(), "SquarePeg") == 0; }));
 
-  REQUIRE(commands.write(give("c2", "SquarePeg")));
+  REQUIRE(commands.write(give("c2", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 4; }));
   CHECK(seen.events[2].state() == cell::ACCEPTED);
   CHECK(seen.events[3].command_id() == "c2");
   CHECK(seen.events[3].state() == cell::ABORTED);
-  CHECK(seen.events[3].reason() == "buffer buffer-1 has no SquarePeg");
+  CHECK(seen.events[3].reason() == "buffer buffer-1 has no SquarePeg free for order o1");
 
   // The same command again (its sender heard nothing): not carried out twice, its last
   // event comes again.
-  REQUIRE(commands.write(give("c2", "SquarePeg")));
+  REQUIRE(commands.write(give("c2", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 5; }));
   CHECK(seen.events[4].command_id() == "c2");
   CHECK(seen.events[4].state() == cell::ABORTED);
-  CHECK(seen.events[4].reason() == "buffer buffer-1 has no SquarePeg");
+  CHECK(seen.events[4].reason() == "buffer buffer-1 has no SquarePeg free for order o1");
 
   CHECK(buffer.stop() == 0);
   REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));

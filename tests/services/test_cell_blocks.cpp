@@ -1,5 +1,9 @@
 // The cell's device blocks and cell-sim's world, driven with events and no DDS.
 
+#include <chrono>
+#include <cmath>
+#include <thread>
+
 #include <catch2/catch.hpp>
 
 #include "services/mobile_robot/mobile_robot_block.hpp"
@@ -56,8 +60,9 @@ TEST_CASE("mobile robot: drive to the buffer, ask it, drive to the station carry
   fb::Data fetch{{"command_id", std::string("f1")}, {"resource_id", std::string("robot-1")},
                  {"operation", std::string("fetch")}, {"order_id", std::string("o1")},
                  {"part", std::string("o1/peg")}, {"part_type", std::string("Peg")},
-                 {"source", std::string("buffer-1")}, {"destination", std::string("station-1")}};
-  f.send("COMMAND", fetch);
+                 {"source", std::string("buffer-1")}, {"destination", std::string("station-1")},
+                 {"source_award", std::string("o1/give/Peg")}};
+  REQUIRE(names<fb::MobileRobotBlock>(f.send("COMMAND", fetch)) == Names{"ACCEPT"});
   const auto to_buffer = f.send("START", {{"command_id", std::string("f1")}});
   REQUIRE(names<fb::MobileRobotBlock>(to_buffer) == Names{"SIM"});
   CHECK(fb::get<std::string>(to_buffer[0].data, "kind") == "move");
@@ -68,6 +73,7 @@ TEST_CASE("mobile robot: drive to the buffer, ask it, drive to the station carry
   REQUIRE(names<fb::MobileRobotBlock>(give) == Names{"GIVE"});
   CHECK(fb::get<std::string>(give[0].data, "resource_id") == "buffer-1");
   CHECK(fb::get<std::string>(give[0].data, "part_type") == "Peg");
+  CHECK(fb::get<std::string>(give[0].data, "award") == "o1/give/Peg");  // the buffer's award, for the buffer
   CHECK(f.send("GIVE_EVENT", {{"command_id", std::string("other")}, {"state", std::string("succeeded")},
                               {"reason", std::string()}}).empty());
   const auto to_station = f.send("GIVE_EVENT", {{"command_id", fb::get<std::string>(give[0].data, "command_id")},
@@ -86,8 +92,9 @@ TEST_CASE("mobile robot: a buffer that refuses fails the fetch with its reason",
   f.send("SIM_REPLY", reply_to(f.send("INIT")[0]));
   fb::Data fetch{{"command_id", std::string("f1")}, {"resource_id", std::string("robot-1")},
                  {"operation", std::string("fetch")}, {"source", std::string("buffer-9")},
-                 {"destination", std::string("station-1")}};
-  f.send("COMMAND", fetch);
+                 {"destination", std::string("station-1")}, {"part_type", std::string("Peg")},
+                 {"source_award", std::string("o1/give/Peg")}};
+  REQUIRE(names<fb::MobileRobotBlock>(f.send("COMMAND", fetch)) == Names{"ACCEPT"});
   const auto unknown = f.send("START", {{"command_id", std::string("f1")}});
   REQUIRE(names<fb::MobileRobotBlock>(unknown) == Names{"FAIL"});
   CHECK(fb::get<std::string>(unknown[0].data, "reason") == "no dock known for buffer-9 or station-1");
@@ -124,9 +131,140 @@ TEST_CASE("device: work queued for an order that has ended fails at once", "[fb]
   fb::BlockTestFixture<fb::MobileRobotBlock> f("robot", "robot-1", fb::Numbers{1, 0, 1}, 0.5);
   f.send("SIM_REPLY", reply_to(f.send("INIT")[0]));
   f.send("COMMAND", {{"command_id", std::string("f1")}, {"resource_id", std::string("robot-1")},
-                     {"operation", std::string("fetch")}, {"order_id", std::string("o1")}});
+                     {"operation", std::string("fetch")}, {"order_id", std::string("o1")},
+                     {"source", std::string("buffer-1")}, {"destination", std::string("station-1")},
+                     {"part_type", std::string("Peg")}, {"source_award", std::string("o1/give/Peg")}});
   f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
   const auto started = f.send("START", {{"command_id", std::string("f1")}});
   REQUIRE(names<fb::MobileRobotBlock>(started) == Names{"FAIL"});
   CHECK(fb::get<std::string>(started[0].data, "reason") == "order o1 has ended");
+}
+
+namespace {
+
+const fb::Data kGrasp{{"part", std::string("o1/B1")}, {"order_id", std::string("o1")},
+                      {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"size", fb::Numbers{0.01, 0.005, 0.01}},
+                      {"direction", fb::Numbers{0, -1, 0}}};
+
+// The reason an arm refuses the command, "" if it accepts it.
+std::string arm_refusal(fb::BlockTestFixture<fb::ArmBlock>& f, const std::string& operation, fb::Data fields) {
+  static int count = 0;
+  const auto out = f.send("COMMAND", command("c" + std::to_string(++count), operation, std::move(fields)));
+  REQUIRE(out.size() == 1);
+  if (out[0].name == "ACCEPT") return "";
+  REQUIRE(out[0].name == "REFUSE");
+  return fb::get<std::string>(out[0].data, "reason");
+}
+
+fb::Data with(fb::Data d, const std::string& key, fb::Value value) {
+  d[key] = std::move(value);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("device: a malformed command is refused with the field, never started", "[fb][device][hostile]") {
+  fb::BlockTestFixture<fb::ArmBlock> f("arm", "arm-1", fb::ArmSettings{});
+  fb::CellBounds bounds;
+  bounds.min = {-5, -1, -5};
+  bounds.max = {5, 3, 5};
+  f.block().set_bounds(bounds);
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  const fb::Data move{{"part", std::string("o1/B1")}, {"path", fb::Numbers{0.1, 0.2, 0.3, 1, 0, 0, 0}}};
+  CHECK(arm_refusal(f, "grip", kGrasp).empty());
+  CHECK(arm_refusal(f, "translate", move).empty());
+  CHECK(arm_refusal(f, "translate", with(move, "path", fb::Numbers{nan, 0.2, 0.3, 1, 0, 0, 0})) ==
+        "path[0]: position (nan, 0.2, 0.3) is not finite");
+  CHECK(arm_refusal(f, "translate", with(move, "path", fb::Numbers{inf, 0.2, 0.3, 1, 0, 0, 0})) ==
+        "path[0]: position (inf, 0.2, 0.3) is not finite");
+  CHECK(arm_refusal(f, "translate", with(move, "path", fb::Numbers{0, 0, 0, 1, 0, 0, 0, 0.1, 0.2, 0.3, nan, 0, 0, 0}))
+            .find("path[1]: orientation is not finite") == 0);
+  CHECK(arm_refusal(f, "translate", with(move, "path", fb::Numbers{0.1, 0.2, 0.3, 0.5, 0, 0, 0})) ==
+        "path[0]: orientation is not a unit quaternion (length 0.500000)");
+  CHECK(arm_refusal(f, "translate", with(move, "path", fb::Numbers{9, 0.2, 0.3, 1, 0, 0, 0})) ==
+        "path[0]: position (9, 0.2, 0.3) is outside the cell (-5, -1, -5) to (5, 3, 5)");
+  CHECK(arm_refusal(f, "translate", with(move, "path", fb::Numbers{})) == "path: 0 poses, not 1 to 2048");
+  fb::Numbers long_path;
+  for (int i = 0; i < 2049; ++i) long_path.insert(long_path.end(), {0, 0, 0, 1, 0, 0, 0});
+  CHECK(arm_refusal(f, "translate", with(move, "path", long_path)) == "path: 2049 poses, not 0 to 2048");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "size", fb::Numbers{-0.01, 0.005, 0.01})) ==
+        "size: (-0.01, 0.005, 0.01) is not a size (each above 0)");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "size", fb::Numbers{nan, 0.005, 0.01})) == "size: (nan, 0.005, 0.01) is not finite");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "direction", fb::Numbers{0, 0, 0})) == "direction: (0, 0, 0) is no direction");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "part", std::string(300, 'x'))) == "part: 300 characters, more than 255");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "sim_time", nan)) == "sim_time: nan is not finite");
+  CHECK(f.block().refused() == 12);
+  CHECK(f.block().last_refusal().find("sim_time: nan is not finite") != std::string::npos);
+  // A refused command was never taken: starting it finds nothing.
+  CHECK(fb::get<std::string>(f.send("START", {{"command_id", std::string("c3")}})[0].data, "reason") == "unknown command");
+}
+
+TEST_CASE("device: only the order its contractor authorises commands it", "[fb][device][hostile]") {
+  fb::BlockTestFixture<fb::ArmBlock> f("arm", "arm-1", fb::ArmSettings{});
+  f.block().authorize_with([](const fb::Data& c) {
+    return fb::get_or<std::string>(c, "order_id", "") == "ok1" ? "" : "arm-1 is reserved by ok1";
+  });
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "order_id", std::string("ok1"))).empty());
+  const auto out = f.send("COMMAND", command("x1", "release", {{"order_id", std::string("intruder")}}));
+  REQUIRE(names<fb::ArmBlock>(out) == Names{"REFUSE"});
+  CHECK(fb::get<std::string>(out[0].data, "reason") == "arm-1 is reserved by ok1");
+  CHECK(fb::get<std::string>(out[0].data, "order_id") == "intruder");
+}
+
+TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "[sim][world][hostile]") {
+  fb::CellBounds bounds;
+  bounds.min = {-5, -1, -5};
+  bounds.max = {5, 3, 5};
+  fb::BlockTestFixture<sim::WorldBlock> f("world", 1000.0, bounds);
+  int count = 0;
+  const auto ask = [&](const std::string& requester, const std::string& kind, const std::string& body, fb::Data d) {
+    d["request_id"] = "r" + std::to_string(++count);
+    d["requester"] = requester;
+    d["kind"] = kind;
+    d["body_id"] = body;
+    std::vector<fb::Event> out = f.send("REQUEST", d);
+    for (int i = 0; i < 100; ++i, out = f.send("TICK")) {  // moves are answered when the sim clock gets there
+      for (const fb::Event& e : out) {
+        if (e.name == "REPLY" && fb::get<std::string>(e.data, "request_id") == "r" + std::to_string(count)) {
+          return fb::get<bool>(e.data, "ok") ? std::string() : fb::get<std::string>(e.data, "error");
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return std::string("no reply");
+  };
+  const fb::Data box{{"placement", fb::Numbers{0, 0.5, 0, 1, 0, 0, 0}}, {"half_extents", fb::Numbers{0.01, 0.01, 0.01}}};
+  const fb::Data table{{"placement", fb::Numbers{0, -0.025, 0, 1, 0, 0, 0}}, {"half_extents", fb::Numbers{1, 0.025, 1}},
+                      {"fixture", true}, {"is_static", true}};
+  CHECK(ask("station-1", "spawn", "table", table).empty());
+  CHECK(ask("ok1", "spawn", "ok1/B1", box).empty());
+  CHECK(ask("arm-1", "spawn", "arm-1/pad", box).empty());
+  CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "half_extents", fb::Numbers{-1, 0.01, 0.01})) ==
+        "half_extents: (-1, 0.01, 0.01) has a negative size");
+  CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "placement", fb::Numbers{0, 0.5, 0, 0, 0, 0, 0})) ==
+        "placement[0]: orientation is not a unit quaternion (length 0.000000)");
+  CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "mesh_uri", std::string("/nonexistent.obj"))) ==
+        "mesh_uri: /nonexistent.obj is not a readable file");
+  CHECK(ask("intruder", "spawn", "x", with(box, "scene", std::string("ok1"))) == "scene ok1 is not intruder's");
+
+  const fb::Data move{{"path", fb::Numbers{0.1, 0.5, 0, 1, 0, 0, 0}}, {"speed", 1.0}, {"angular_speed", 1.0}};
+  CHECK(ask("ok1", "move", "ok1/B1", with(move, "speed", std::nan(""))) == "speed: nan is not finite");
+  CHECK(ask("ok1", "move", "ok1/B1", with(move, "speed", 0.0)) == "speed: must be above 0");
+  CHECK(ask("ok1", "move", "ok1/B1", with(move, "path", fb::Numbers{0, 1e9, 0, 1, 0, 0, 0})).find("outside the cell") !=
+        std::string::npos);
+  // Another requester may not touch ok1's part, nor anyone the cell's fixtures.
+  CHECK(ask("intruder", "remove", "ok1/B1", {}) == "ok1/B1 belongs to ok1, not to intruder");
+  CHECK(ask("intruder", "set_movable", "table", {}) == "table is a fixture of the cell");
+  CHECK(ask("station-1", "remove", "table", {}) == "table is a fixture of the cell");
+  CHECK(ask("intruder", "move", "ok1/B1", move) == "ok1/B1 belongs to ok1, not to intruder");
+  // The arm carries ok1's part only while ok1 has hired it.
+  const fb::Data carry = with(with(move, "carried", std::string("ok1/B1")), "order_id", std::string("ok1"));
+  CHECK(ask("arm-1", "move", "arm-1/pad", carry) == "ok1/B1 belongs to order ok1, which has not hired arm-1");
+  f.send("HIRED", {{"resource_id", std::string("arm-1")}, {"order_id", std::string("ok1")}});
+  CHECK(ask("arm-1", "move", "arm-1/pad", carry).empty());
+  CHECK(f.block().world().pose("ok1/B1")->translation().x() == Approx(0.1));
+  CHECK(ask("intruder", "move", "arm-1/pad", carry) == "arm-1/pad belongs to arm-1, not to intruder");
+  f.send("ORDER_ENDED", {{"order_id", std::string("ok1")}});
+  CHECK_FALSE(f.block().world().pose("ok1/B1"));
+  CHECK(f.block().world().pose("table"));
 }

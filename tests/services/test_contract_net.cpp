@@ -58,6 +58,12 @@ TEST_CASE("contractor: bids only for what it offers, after the orders it holds a
   const auto queued = f.send("AWARD", award("o2", "host"));
   CHECK(fb::get<bool>(queued[0].data, "confirmed"));
   CHECK(fb::get<std::int64_t>(queued[0].data, "ahead") == 1);
+  // Commands: only the holder's, under the award it holds by.
+  CHECK(f.block().refusal("o1", "o1/host").empty());
+  CHECK(f.block().refusal("o2", "o2/host") == "station-1 is reserved by o1");
+  CHECK(f.block().refusal("o1", "o2/host") == "station-1 has no award o2/host of order o1");
+  CHECK(f.block().refusal("o1", "") == "the command names no award of station-1");
+  CHECK(f.block().refusal("intruder", "o1/host") == "station-1 is reserved by o1");
   CHECK(fb::get<double>(f.send("CFP", cfp("o3", "host", 5))[0].data, "earliest_start") == 150);
   CHECK(fb::get<std::int64_t>(f.send("AWARD", award("o3", "host"))[0].data, "ahead") == 2);
   CHECK(f.block().waiting() == Names{"o2", "o3"});
@@ -68,10 +74,18 @@ TEST_CASE("contractor: bids only for what it offers, after the orders it holds a
   REQUIRE(names<fb::Contractor>(next) == Names{"RESERVED"});
   CHECK(fb::get<std::string>(next[0].data, "order_id") == "o3");
   CHECK(f.block().waiting().empty());
-  // An award it never offered for is refused with the reason.
+  CHECK(f.block().refusal("o3", "o3/host").empty());
+  // An award it never offered for is refused with the reason; so is another order's bid.
   const auto unknown = f.send("AWARD", award("o9", "host"));
   CHECK_FALSE(fb::get<bool>(unknown[0].data, "confirmed"));
   CHECK(fb::get<std::string>(unknown[0].data, "reason").find("made no offer") != std::string::npos);
+  f.send("CFP", cfp("o4", "host", 5));
+  fb::Data stolen = award("o4", "host");
+  stolen["order_id"] = std::string("intruder");
+  const auto theft = f.send("AWARD", stolen);
+  CHECK_FALSE(fb::get<bool>(theft[0].data, "confirmed"));
+  CHECK(fb::get<std::string>(theft[0].data, "reason") == "call o4/host was made by order o4");
+  CHECK(f.block().waiting().empty());
 }
 
 TEST_CASE("contractor: a shared resource takes work into its queue and bids after it", "[fb][negotiation]") {
@@ -83,7 +97,8 @@ TEST_CASE("contractor: a shared resource takes work into its queue and bids afte
   REQUIRE(names<fb::Contractor>(taken) == Names{"REPLY", "AWARDED"});
   CHECK(fb::get<std::string>(taken[1].data, "order_id") == "o1");
   CHECK(f.block().reserved_by().empty());
-  CHECK(f.block().serves("o1"));
+  CHECK(f.block().refusal("o1", "o1/fetch").empty());
+  CHECK(f.block().refusal("o2", "o2/fetch") == "robot-1 has no award o2/fetch of order o2");
   CHECK(fb::get<double>(f.send("CFP", cfp("o2", "fetch", 4))[0].data, "earliest_start") == 18);
   f.send("AWARD", award("o2", "fetch", "robot-1"));
   CHECK(fb::get<double>(f.send("CFP", cfp("o3", "fetch", 4))[0].data, "earliest_start") == 22);
@@ -91,7 +106,7 @@ TEST_CASE("contractor: a shared resource takes work into its queue and bids afte
   f.send("IDLE");  // the work ran out early: the estimate starts again from now
   CHECK(fb::get<double>(f.send("CFP", cfp("o3", "fetch", 4))[0].data, "earliest_start") == 15);
   f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
-  CHECK_FALSE(f.block().serves("o1"));
+  CHECK(f.block().refusal("o1", "o1/fetch") == "robot-1 has no award o1/fetch of order o1");
 }
 
 TEST_CASE("contractor: a refusal says why", "[fb][negotiation]") {

@@ -56,10 +56,8 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       if (state() == "WAITING_CELL") try_begin_virtual();
       if (state() == "QUEUED" && id == station_) on_queue_news(p);
       if (state() == "QUEUED" && p.kind == "station" && id != station_) consider_moving_to(id);
-      if (state() == "HIRING" && id == arm_ && p.reserved_by == settings_.order_id) {
-        arm_held_ = true;
-        start_physical_when_hired();
-      }
+      if (state() == "HIRING" && id == arm_ && p.reserved_by == settings_.order_id) arm_held_ = true;
+      if (state() == "HIRING") start_physical_when_hired();
     });
   }
 
@@ -114,14 +112,14 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       if (state == "succeeded") {
         delivered_.insert(id);
         if (action_running_ && actions_.front().kind == Action::await_delivery && awaited_id_ == id) action_done();
-      } else if (state == "aborted") {
+      } else if (state == "aborted" || state == "rejected") {
         fail("fetching " + product_.product.parts()[fetch->second].name + " failed: " + get<std::string>(d, "reason"));
       }
       return;
     }
     if (!action_running_ || id != awaited_id_) return;
     if (state == "succeeded") return action_done();
-    if (state != "aborted") return;
+    if (state != "aborted" && state != "rejected") return;
     fail(fb::get_or<std::string>(d, "resource_id", "") + " " + get<std::string>(actions_.front().data, "operation") +
          " failed: " + get<std::string>(d, "reason"));
   });
@@ -250,6 +248,7 @@ void OrderOrchestrator::on_awarded(const Data& d) {
   const std::string what = get<std::string>(d, "call_id").substr(settings_.order_id.size() + 1);
   const std::string& resource = get<std::string>(d, "resource_id");
   awarded_.insert(resource);
+  award_of_[resource] = get<std::string>(d, "call_id");
   const long ahead = static_cast<long>(get<std::int64_t>(d, "ahead"));
   if (what == kHost) {
     station_ = resource;
@@ -283,8 +282,13 @@ void OrderOrchestrator::hire_robot_when_ready() {
                 {"count", std::int64_t(sources.size())}, {"duration", 0.0}});
 }
 
+// Also once the places of the station and the buffers are known: a resource's proposal may
+// come before its capability (DDS matches each pair of endpoints on its own).
 void OrderOrchestrator::start_physical_when_hired() {
-  if (state() != "HIRING" || robot_.empty() || arm_.empty() || !arm_held_) return;
+  if (state() != "HIRING" || robot_.empty() || arm_.empty() || !arm_held_ || !places_.count(station_)) return;
+  for (const auto& [type, buffer] : buffer_of_) {
+    if (!places_.count(buffer)) return;
+  }
   enter("PHYSICAL");
   plan_physical();
 }
@@ -324,7 +328,8 @@ std::string OrderOrchestrator::physical_body(PartIndex part) const {
 
 Data OrderOrchestrator::command(const std::string& resource, const std::string& operation, const std::string& part) {
   return {{"command_id", settings_.order_id + "/" + std::to_string(++command_count_) + "/" + operation},
-          {"resource_id", resource}, {"order_id", settings_.order_id}, {"operation", operation}, {"part", part}};
+          {"resource_id", resource}, {"order_id", settings_.order_id}, {"operation", operation}, {"part", part},
+          {"award", award_of_[resource]}};
 }
 
 // Virtual assembly of one candidate trajectory, all in cell-sim: the part and a gripper of
@@ -440,6 +445,7 @@ void OrderOrchestrator::plan_physical() {
     fetch["part_type"] = type;
     fetch["source"] = buffer;
     fetch["destination"] = station_;
+    fetch["source_award"] = settings_.order_id + "/" + kGive + type;
     fetch_of_[get<std::string>(fetch, "command_id")] = step.part;
     fetches.push_back(get<std::string>(fetch, "command_id"));
     actions_.push_back({Action::send_only, fetch});

@@ -147,6 +147,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::string station_, arm_, robot_;
   std::map<std::string, std::string> buffer_of_;  // part type -> buffer
   std::set<std::string> awarded_;                 // every resource to release at the end
+  std::map<std::string, std::string> award_of_;   // resource -> the call it was awarded (commands name it)
   long ahead_ = -1;                               // in the station's queue, as last reported
   bool arm_held_ = false;
   std::set<std::string> delivered_, spawned_;

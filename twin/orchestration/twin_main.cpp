@@ -197,13 +197,16 @@ class TwinProcess {
                                                 [](const fb::Data& d) { return dds::to_award(d); });
     publish<cell::Release, cell::ReleasePubSubType>(r, "releases", "cell/negotiation/releases", "orchestrator",
                                                     "RELEASE", [](const fb::Data& d) { return dds::to_release(d); });
-    publish<cell::Command, cell::CommandPubSubType>(r, "commands", "cell/commands", "orchestrator", "COMMAND",
-                                                    [this](const fb::Data& d) {
-      cell::Command c = dds::to_command(d);
-      c.sim_time(clock_.now());
-      if (options_.verbose) std::cout << "  command " << c.command_id() << " to " << c.resource_id() << std::endl;
-      return c;
-    });
+    r.add(std::make_unique<dds::RoutedPublishBlock<cell::Command, cell::CommandPubSubType>>(
+        "commands", participant_,
+        [](const fb::Data& d) { return dds::command_topic(fb::get<std::string>(d, "resource_id")); },
+        [this](const fb::Data& d) {
+          cell::Command c = dds::to_command(d);
+          c.sim_time(clock_.now());
+          if (options_.verbose) std::cout << "  command " << c.command_id() << " to " << c.resource_id() << std::endl;
+          return c;
+        }));
+    r.connect("orchestrator", "COMMAND", "commands", "REQ");
     publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "orchestrator",
                                                                 "CANCEL", [](const fb::Data& d) {
                                                                   cell::CancelRequest c;
