@@ -5,7 +5,6 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 
-constexpr int kMaxQueuedEvents = 4096;
 
 template <class Qos>
 void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
@@ -32,7 +31,7 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
     qos.history().kind = KEEP_ALL_HISTORY_QOS;
     // Readers take every sample as it comes; a reader this far behind is under a flood, and
     // a reliable writer then waits (its own write times out): the flood slows its sender.
-    qos.resource_limits().max_samples = kMaxQueuedEvents;
+    qos.resource_limits().max_samples = settings.max_queued;
   }
 }
 

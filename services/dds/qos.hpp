@@ -16,7 +16,18 @@ enum class TopicKind { state, events };
 
 struct QosSettings {
   double liveliness_lease_s = 5.0;  // a state writer silent this long is taken for dead
+  // Events: samples a reader holds before it has taken them, and a writer before every reader
+  // has them. Buffers grow to this and never shrink.
+  int max_queued = 4096;
 };
+
+// A resource's command topic: one reader, commanded one step at a time by the orders that
+// hired it; a flood fills this little and then waits at its sender.
+inline QosSettings command_qos() {
+  QosSettings s;
+  s.max_queued = 64;
+  return s;
+}
 
 eprosima::fastdds::dds::DataWriterQos writer_qos(TopicKind kind, const QosSettings& settings = {});
 eprosima::fastdds::dds::DataReaderQos reader_qos(TopicKind kind, const QosSettings& settings = {});

@@ -58,9 +58,10 @@ class SubscribeBlock : public fb::FunctionBlock {
  public:
   using ToData = std::function<fb::Data(const T&)>;
 
-  SubscribeBlock(std::string name, ParticipantPtr participant, std::string topic, TopicKind kind, ToData to_data)
+  SubscribeBlock(std::string name, ParticipantPtr participant, std::string topic, TopicKind kind, ToData to_data,
+                 QosSettings settings = {})
       : FunctionBlock(std::move(name)), participant_(std::move(participant)), topic_(std::move(topic)), kind_(kind),
-        to_data_(std::move(to_data)) {
+        to_data_(std::move(to_data)), settings_(settings) {
     declare_input("RECEIVED");  // from the DDS listener thread, through the resource's queue
     declare_input("LOST");
     declare_output("IND");
@@ -71,7 +72,7 @@ class SubscribeBlock : public fb::FunctionBlock {
   void start() {
     reader_ = std::make_unique<Reader<T, PubSubType>>(
         participant_, topic_, kind_, [this](const T& s) { deliver("RECEIVED", s); },
-        [this](const T& s) { deliver("LOST", s); });
+        [this](const T& s) { deliver("LOST", s); }, settings_);
   }
 
   void receive(const fb::Event& event) override {
@@ -106,6 +107,7 @@ class SubscribeBlock : public fb::FunctionBlock {
   std::string topic_;
   TopicKind kind_;
   ToData to_data_;
+  QosSettings settings_;
   std::function<void(const T&, const std::string&)> on_refused_;
   std::unique_ptr<Reader<T, PubSubType>> reader_;
 };
@@ -116,9 +118,10 @@ class RoutedPublishBlock : public fb::FunctionBlock {
   using ToSample = std::function<T(const fb::Data&)>;
   using Route = std::function<std::string(const fb::Data&)>;  // the topic for the data
 
-  RoutedPublishBlock(std::string name, ParticipantPtr participant, Route route, ToSample to_sample)
+  RoutedPublishBlock(std::string name, ParticipantPtr participant, Route route, ToSample to_sample,
+                     QosSettings settings = {})
       : FunctionBlock(std::move(name)), participant_(std::move(participant)), route_(std::move(route)),
-        to_sample_(std::move(to_sample)) {
+        to_sample_(std::move(to_sample)), settings_(settings) {
     declare_input("REQ");
     declare_output("CNF");
     declare_output("ERROR", {"reason"});
@@ -130,7 +133,7 @@ class RoutedPublishBlock : public fb::FunctionBlock {
       const std::string topic = route_(event.data);
       auto& writer = writers_[topic];
       if (!writer) {
-        writer = std::make_unique<Writer<T, PubSubType>>(participant_, topic, TopicKind::events);
+        writer = std::make_unique<Writer<T, PubSubType>>(participant_, topic, TopicKind::events, settings_);
         // The reader is there (its resource was hired): wait for the match, which takes
         // milliseconds between participants that know each other, so the first sample is not lost.
         writer->wait_for_readers(1, std::chrono::seconds(1));
@@ -146,6 +149,7 @@ class RoutedPublishBlock : public fb::FunctionBlock {
   ParticipantPtr participant_;
   Route route_;
   ToSample to_sample_;
+  QosSettings settings_;
   std::map<std::string, std::unique_ptr<Writer<T, PubSubType>>> writers_;
 };
 

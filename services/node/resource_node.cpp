@@ -77,6 +77,7 @@ struct ResourceNode::Impl {
   // Answers to commands the resource's queue had no room for, written on the listener thread.
   std::unique_ptr<dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>> overflow_answers;
   std::atomic<std::size_t> overflowed{0};
+  std::size_t overflowed_published = 0;  // resource thread only
   std::mutex refusal_mutex;
   std::string last_overflow;
   std::vector<std::function<void()>> starters;
@@ -92,8 +93,9 @@ struct ResourceNode::Impl {
 
   template <class T, class P>
   Sub<T, P>& subscribe(const std::string& name, const std::string& topic, TopicKind kind,
-                       typename Sub<T, P>::ToData to_data) {
-    auto& block = resource.add(std::make_unique<Sub<T, P>>(name, participant, topic, kind, std::move(to_data)));
+                       typename Sub<T, P>::ToData to_data, const dds::QosSettings& settings = {}) {
+    auto& block =
+        resource.add(std::make_unique<Sub<T, P>>(name, participant, topic, kind, std::move(to_data), settings));
     starters.push_back([&block] { block.start(); });
     return block;
   }
@@ -119,7 +121,8 @@ struct ResourceNode::Impl {
     c.waiting(cell::Ids(waiting.begin(), waiting.end()));
     c.queued_commands(static_cast<int32_t>(lifecycle->queued()));
     c.busy(busy);
-    c.refused_commands(static_cast<int32_t>(device.refused() + overflowed));
+    overflowed_published = overflowed;
+    c.refused_commands(static_cast<int32_t>(device.refused() + overflowed_published));
     {
       std::lock_guard<std::mutex> lock(refusal_mutex);
       const std::string& last = last_overflow.empty() ? device.last_refusal() : last_overflow;
@@ -189,7 +192,8 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   });
   auto& commands = n.subscribe<cell::Command, cell::CommandPubSubType>(
       "commands", dds::command_topic(me), TopicKind::events,
-      [me](const cell::Command& c) { return c.resource_id().to_string() == me ? dds::to_data(c) : fb::Data{}; });
+      [me](const cell::Command& c) { return c.resource_id().to_string() == me ? dds::to_data(c) : fb::Data{}; },
+      dds::command_qos());
   n.overflow_answers = std::make_unique<dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>>(
       participant, "cell/command_events", TopicKind::events);
   commands.on_refused([&n](const cell::Command& c, const std::string& why) {
@@ -208,6 +212,10 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     n.last_overflow = c.order_id().to_string() + " " + c.command_id().to_string() + ": " + why;
   });
   resource.connect("commands", "IND", dev, "COMMAND");
+  // Refusals counted on the listener thread while the queue was full, published once it is quiet.
+  resource.on_idle([&n] {
+    if (n.overflowed != n.overflowed_published) n.publish_capability();
+  });
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
       "cancels", "cell/cancel_requests", TopicKind::events,
       [](const cell::CancelRequest& c) { return fb::Data{{"command_id", c.command_id().to_string()}}; });
@@ -284,7 +292,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   }
 }
 
-ResourceNode::~ResourceNode() = default;
+ResourceNode::~ResourceNode() { impl_->resource.on_idle({}); }
 
 void ResourceNode::start(std::chrono::milliseconds wait_for_sim) {
   Impl& n = *impl_;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -54,8 +55,10 @@ class Resource {
   bool run_one();
   // Delivers events until none is left; returns how many.
   std::size_t run_until_idle();
-  // Waits up to `timeout` for an event and delivers it; false on time-out.
+  // Waits up to `timeout` for an event and delivers it; false on time-out, after calling the
+  // idle hook (on this thread: what a listener thread could not post while the queue was full).
   bool wait_and_run_one(std::chrono::milliseconds timeout);
+  void on_idle(std::function<void()> idle);
 
   std::size_t refused() const { return refused_; }
   // Events whose block threw: the exception is caught, said on stderr and counted here.
@@ -84,6 +87,7 @@ class Resource {
   bool closed_ = false;
   std::atomic<std::size_t> refused_{0};
   std::atomic<std::size_t> failed_{0};
+  std::function<void()> idle_;
 };
 
 }  // namespace fb

@@ -160,11 +160,21 @@ std::size_t Resource::run_until_idle() {
 }
 
 bool Resource::wait_and_run_one(std::chrono::milliseconds timeout) {
+  bool ready = false;
+  std::function<void()> idle;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty(); })) return false;
+    ready = ready_.wait_for(lock, timeout, [&] { return !queue_.empty(); });
+    if (!ready) idle = idle_;
   }
-  return run_one();
+  if (ready) return run_one();
+  if (idle) idle();
+  return false;
+}
+
+void Resource::on_idle(std::function<void()> idle) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  idle_ = std::move(idle);
 }
 
 }  // namespace fb

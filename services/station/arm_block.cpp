@@ -76,7 +76,7 @@ void ArmBlock::check(const Data& command, SampleCheck& c) const {
     const Numbers& push = get_or<Numbers>(command, "direction", {});
     c.require(push.size() != 3 || push[0] != 0 || push[1] != 0 || push[2] != 0, "direction: (0, 0, 0) is no direction");
   } else if (operation == "translate" || operation == "rotate") {
-    c.poses("path", 1).text("part", true);
+    c.poses("path", 1);
   } else if (operation == "connect" || operation == "disconnect") {
     c.text("part", true);
   }

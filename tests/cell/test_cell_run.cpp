@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
-#include "tests/support/child_process.hpp"
+#include "tests/support/cell_test.hpp"
 
 namespace {
 
@@ -25,32 +25,15 @@ using namespace std::chrono_literals;
 
 const std::string kCell = DEFAULT_CELL;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("agile-cell-test-" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::cellctl;
+using test::read_text;
+using test::scratch;
 
 std::vector<json> read_events(const fs::path& file) {
   std::vector<json> out;
   std::ifstream in(file);
   for (std::string line; std::getline(in, line);) out.push_back(json::parse(line));
   return out;
-}
-
-// `cellctl ARGS...` to its end (bounded), output in `log`; its exit code.
-int cellctl(std::vector<std::string> args, const fs::path& log, std::chrono::seconds timeout = 120s) {
-  args.insert(args.begin(), CELLCTL_EXE);
-  test::ChildProcess p(args, log.string());
-  return p.wait_for_exit(timeout);
 }
 
 // The part's name from its body id: "ORDER/NAME" or "ORDER/virtual/NAME".

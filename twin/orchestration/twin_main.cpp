@@ -205,7 +205,8 @@ class TwinProcess {
           c.sim_time(clock_.now());
           if (options_.verbose) std::cout << "  command " << c.command_id() << " to " << c.resource_id() << std::endl;
           return c;
-        }));
+        },
+        dds::command_qos()));
     r.connect("orchestrator", "COMMAND", "commands", "REQ");
     publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "orchestrator",
                                                                 "CANCEL", [](const fb::Data& d) {

@@ -1,0 +1,72 @@
+#pragma once
+// What the process tests share: a scratch folder per test, reading a log, running cellctl to
+// its end with a bound, and the resident memory of a process.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/support/child_process.hpp"
+
+namespace test {
+
+inline std::filesystem::path scratch(const std::string& name) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("agile-cell-test-" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+inline std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// `cellctl ARGS...` to its end (bounded), output in `log`; its exit code.
+inline int cellctl(std::vector<std::string> args, const std::filesystem::path& log,
+                   std::chrono::seconds timeout = std::chrono::seconds(120)) {
+  args.insert(args.begin(), CELLCTL_EXE);
+  ChildProcess p(args, log.string());
+  return p.wait_for_exit(timeout);
+}
+
+// VmRSS of a process in kB, 0 when it is gone.
+inline long rss_kb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return 0;
+}
+
+// The children of `parent` by their command's file name (cell processes under `cellctl up`).
+inline std::vector<std::pair<std::string, pid_t>> children_of(pid_t parent) {
+  std::vector<std::pair<std::string, pid_t>> out;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat(entry.path() / "stat");
+    std::string line;
+    if (!std::getline(stat, line)) continue;
+    const auto close = line.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(line.substr(close + 2));
+    char state;
+    pid_t ppid = 0;
+    rest >> state >> ppid;
+    if (ppid != parent) continue;
+    const auto open = line.find('(');
+    out.push_back({line.substr(open + 1, close - open - 1), static_cast<pid_t>(std::stol(name))});
+  }
+  return out;
+}
+
+}  // namespace test
