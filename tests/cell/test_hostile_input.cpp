@@ -27,6 +27,12 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kUnderAddressSanitizer = true;
+#else
+constexpr bool kUnderAddressSanitizer = false;
+#endif
+
 const std::string kLego = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
 const std::vector<std::string> kResources{"station-1", "arm-1", "mobile-robot-1", "buffer-1", "buffer-2"};
 
@@ -457,6 +463,10 @@ TEST_CASE("hostile: a burst of 10,000 commands: each gets a final event, the sta
   std::this_thread::sleep_for(2s);
   const long after = cell.rss().at("station");
   INFO("station " << before << " kB before, " << after << " kB after");
-  CHECK(after <= before * 1.1);
+  if (kUnderAddressSanitizer) {
+    WARN("memory not checked: AddressSanitizer keeps freed memory in its quarantine");
+  } else {
+    CHECK(after <= before * 1.1);
+  }
   CHECK(cell.order_succeeds("ok1"));
 }
