@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "services/blocks/sample_checks.hpp"
+
 namespace twin {
 namespace {
 
@@ -45,9 +47,16 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
 
   const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
                               "HIRING", "PHYSICAL",     "CLEANUP", "ENDED"};
-  // What the cell's resources say of themselves, in every state.
+  // What the cell's resources say of themselves, in every state; a place that is no place
+  // (a position that is not finite) is not taken.
+  const auto is_place = [](const Data& d) {
+    fb::SampleCheck check(d);
+    check.vector("position").vector("dock").at_least("speed", 0).at_least("angular_speed", 0);
+    return check.ok();
+  };
   for (const char* in : all_states) {
-    transition(in, "CAPABILITY", in, [this](const Data& d) {
+    transition(in, "CAPABILITY", in, [this, is_place](const Data& d) {
+      if (!is_place(d)) return;
       Place& p = places_[get<std::string>(d, "resource_id")];
       p = {get<std::string>(d, "kind"), get<Numbers>(d, "position"), get<Numbers>(d, "dock"), get<double>(d, "speed"),
            get<double>(d, "angular_speed"), get<std::string>(d, "reserved_by"),
