@@ -43,7 +43,8 @@ SampleCheck& SampleCheck::text(const char* key, bool required, std::size_t max_l
   if (it != data_.end() && !value) {
     fail(std::string(key) + ": not a text");
   } else if (value && value->size() > max_length) {
-    fail(std::string(key) + ": " + std::to_string(value->size()) + " characters, more than " + std::to_string(max_length));
+    fail(std::string(key) + ": " + std::to_string(value->size()) + " characters, more than " +
+         std::to_string(max_length));
   } else if (required && (!value || value->empty())) {
     fail(std::string(key) + ": empty");
   }
@@ -130,7 +131,8 @@ SampleCheck& SampleCheck::names(const char* key, std::size_t max_count) {
   const std::string* value = it == data_.end() ? nullptr : std::get_if<std::string>(&it->second);
   if (!ok() || !value) return *this;
   const std::vector<std::string> list = split_names(*value);
-  if (list.size() > max_count) fail(std::string(key) + ": " + std::to_string(list.size()) + " names, more than " + std::to_string(max_count));
+  if (list.size() > max_count)
+    fail(std::string(key) + ": " + std::to_string(list.size()) + " names, more than " + std::to_string(max_count));
   for (const std::string& name : list) {
     if (name.size() > kMaxTextLength) fail(std::string(key) + ": a name longer than " + std::to_string(kMaxTextLength));
   }

@@ -47,7 +47,9 @@ fb::Numbers to_numbers(const std::vector<cell::Pose>& path) {
 }
 
 std::vector<cell::Pose> to_path(const fb::Numbers& n) {
-  if (n.size() % 7 != 0) throw std::invalid_argument("a path needs seven numbers per pose, got " + std::to_string(n.size()));
+  if (n.size() % 7 != 0) {
+    throw std::invalid_argument("a path needs seven numbers per pose, got " + std::to_string(n.size()));
+  }
   if (n.size() / 7 > static_cast<std::size_t>(cell::MAX_WAYPOINTS)) {
     throw std::length_error("a path of " + std::to_string(n.size() / 7) + " poses, more than " +
                             std::to_string(cell::MAX_WAYPOINTS));
@@ -119,11 +121,19 @@ cell::CommandEvent to_command_event(const fb::Data& d) {
 }
 
 fb::Data to_data(const cell::Command& c) {
-  return {{"command_id", c.command_id().to_string()},   {"resource_id", c.resource_id().to_string()}, {"order_id", c.order_id().to_string()},
-          {"operation", c.operation().to_string()},     {"part", c.part().to_string()},               {"part_type", c.part_type().to_string()},
-          {"source", c.source().to_string()},           {"destination", c.destination().to_string()}, {"award", c.award().to_string()},
-          {"source_award", c.source_award().to_string()}, {"path", to_numbers(c.path())},
-          {"size", to_numbers(c.size())},   {"direction", to_numbers(c.direction())},
+  return {{"command_id", c.command_id().to_string()},
+          {"resource_id", c.resource_id().to_string()},
+          {"order_id", c.order_id().to_string()},
+          {"operation", c.operation().to_string()},
+          {"part", c.part().to_string()},
+          {"part_type", c.part_type().to_string()},
+          {"source", c.source().to_string()},
+          {"destination", c.destination().to_string()},
+          {"award", c.award().to_string()},
+          {"source_award", c.source_award().to_string()},
+          {"path", to_numbers(c.path())},
+          {"size", to_numbers(c.size())},
+          {"direction", to_numbers(c.direction())},
           {"sim_time", c.sim_time()}};
 }
 
@@ -147,9 +157,16 @@ cell::Command to_command(const fb::Data& d) {
 }
 
 fb::Data to_data(const cell::SimReply& r) {
-  return {{"request_id", r.request_id().to_string()}, {"requester", r.requester().to_string()}, {"ok", r.ok()}, {"error", r.error().to_string()},
-          {"collided", r.collided()},     {"hit_body", r.hit_body().to_string()}, {"hit_member", r.hit_member().to_string()},
-          {"depth", r.depth()},           {"start_time", r.start_time()}, {"end_time", r.end_time()},
+  return {{"request_id", r.request_id().to_string()},
+          {"requester", r.requester().to_string()},
+          {"ok", r.ok()},
+          {"error", r.error().to_string()},
+          {"collided", r.collided()},
+          {"hit_body", r.hit_body().to_string()},
+          {"hit_member", r.hit_member().to_string()},
+          {"depth", r.depth()},
+          {"start_time", r.start_time()},
+          {"end_time", r.end_time()},
           {"distance", r.distance()}};
 }
 
@@ -218,9 +235,10 @@ cell::SimReply to_sim_reply(const fb::Data& d) {
 namespace dds {
 
 fb::Data to_data(const cell::CallForProposals& c) {
-  return {{"call_id", c.call_id().to_string()},     {"order_id", c.order_id().to_string()}, {"operation", c.operation().to_string()},
-          {"part_type", c.part_type().to_string()}, {"count", std::int64_t(c.count())}, {"station", c.station().to_string()},
-          {"sources", names(c.sources())}, {"duration", c.duration()}};
+  return {{"call_id", c.call_id().to_string()},     {"order_id", c.order_id().to_string()},
+          {"operation", c.operation().to_string()}, {"part_type", c.part_type().to_string()},
+          {"count", std::int64_t(c.count())},       {"station", c.station().to_string()},
+          {"sources", names(c.sources())},          {"duration", c.duration()}};
 }
 
 cell::CallForProposals to_call(const fb::Data& d) {
@@ -237,8 +255,9 @@ cell::CallForProposals to_call(const fb::Data& d) {
 }
 
 fb::Data to_data(const cell::Proposal& p) {
-  return {{"call_id", p.call_id().to_string()},   {"resource_id", p.resource_id().to_string()}, {"available", p.available()},
-          {"reason", p.reason().to_string()},     {"earliest_start", p.earliest_start()}, {"duration", p.duration()}};
+  return {{"call_id", p.call_id().to_string()},   {"resource_id", p.resource_id().to_string()},
+          {"available", p.available()},           {"reason", p.reason().to_string()},
+          {"earliest_start", p.earliest_start()}, {"duration", p.duration()}};
 }
 
 cell::Proposal to_proposal(const fb::Data& d) {
@@ -253,7 +272,10 @@ cell::Proposal to_proposal(const fb::Data& d) {
 }
 
 fb::Data to_data(const cell::Award& a) {
-  return {{"call_id", a.call_id().to_string()}, {"resource_id", a.resource_id().to_string()}, {"order_id", a.order_id().to_string()}, {"lease", a.lease()}};
+  return {{"call_id", a.call_id().to_string()},
+          {"resource_id", a.resource_id().to_string()},
+          {"order_id", a.order_id().to_string()},
+          {"lease", a.lease()}};
 }
 
 cell::Award to_award(const fb::Data& d) {
@@ -266,9 +288,9 @@ cell::Award to_award(const fb::Data& d) {
 }
 
 fb::Data to_data(const cell::AwardReply& r) {
-  return {{"call_id", r.call_id().to_string()}, {"resource_id", r.resource_id().to_string()},
-          {"order_id", r.order_id().to_string()},     {"confirmed", r.confirmed()},
-          {"reason", r.reason().to_string()},   {"ahead", std::int64_t(r.ahead())}};
+  return {{"call_id", r.call_id().to_string()},   {"resource_id", r.resource_id().to_string()},
+          {"order_id", r.order_id().to_string()}, {"confirmed", r.confirmed()},
+          {"reason", r.reason().to_string()},     {"ahead", std::int64_t(r.ahead())}};
 }
 
 cell::AwardReply to_award_reply(const fb::Data& d) {
@@ -282,7 +304,9 @@ cell::AwardReply to_award_reply(const fb::Data& d) {
   return r;
 }
 
-fb::Data to_data(const cell::Release& r) { return {{"order_id", r.order_id().to_string()}, {"resource_id", r.resource_id().to_string()}}; }
+fb::Data to_data(const cell::Release& r) {
+  return {{"order_id", r.order_id().to_string()}, {"resource_id", r.resource_id().to_string()}};
+}
 
 cell::Release to_release(const fb::Data& d) {
   cell::Release r;

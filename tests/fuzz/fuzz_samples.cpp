@@ -64,7 +64,8 @@ void feed_contractor(const char* input, const fb::Data& data) {
       [](const fb::Data& call) { return fb::Contractor::Estimate{true, "", fb::get_or<double>(call, "duration", 0)}; },
       [] { return 10.0; });
   deliver(f, input, data);
-  fb::Data award = data;  // and an award of whatever it was, to this resource
+  if (std::string(input) != "CFP") return;
+  fb::Data award = data;  // the call's own award, to this resource
   award["resource_id"] = std::string("arm-1");
   deliver(f, "AWARD", award);
 }
