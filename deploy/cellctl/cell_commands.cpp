@@ -16,6 +16,7 @@
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
 #include "deploy/cellctl/processes.hpp"
+#include "deploy/cellctl/supervisor.hpp"
 #include "deploy/cellctl/text_table.hpp"
 
 namespace cellctl {
@@ -227,19 +228,28 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
     CellObserver observer(cell.domain, cell.localhost_only);
-    RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
+    Supervisor supervisor(cell_processes(cell, executable_dir()), cell.restart,
+                          [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; });
+    const auto missing = observer.wait_for_resources(cell.resource_ids(), std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
+    if (!missing.empty()) {
+      std::string list;
+      for (const auto& m : missing) list += " " + m;
+      throw std::runtime_error("the cell did not come up within " + std::to_string(static_cast<int>(cell_options->wait_s)) +
+                               " s; missing:" + list);
+    }
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n';
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size()
               << " resources); `cellctl down --domain " << cell.domain << "` stops it" << std::endl;
     while (!stop_requested) {
-      if (Process* p = running.ended()) {
-        std::cerr << "error: " << p->name() << " ended (exit " << p->poll() << "); stopping the cell\n";
+      if (const std::string why = supervisor.tend(); !why.empty()) {
+        std::cerr << "error: " << why << "; stopping the cell. Look at that process's output above, fix the cause, "
+                  << "and start the cell again\n";
         exit_code = 1;
         break;
       }
       std::this_thread::sleep_for(100ms);
     }
-    running.stop();
+    supervisor.stop();
     fs::remove(pid_file(cell.domain));
     std::cout << "cell down" << std::endl;
   });

@@ -162,7 +162,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds"});
+              "mobile_robots", "buffers", "bounds", "restart"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -185,6 +185,16 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     buffer_nodes.push_back(b);
   }
   read_bounds(file, root, c);
+  if (const YAML::Node restart = root["restart"]) {
+    known_keys(file, restart, {"limit", "window"});
+    long window = c.restart.window.count();
+    read(file, restart, "limit", c.restart.limit);
+    read(file, restart, "window", window);
+    if (c.restart.limit < 0 || window <= 0) {
+      throw ConfigError(where(file, restart) + ": limit must be 0 or more and window above 0");
+    }
+    c.restart.window = std::chrono::seconds(window);
+  }
   std::vector<std::pair<std::string, YAML::Node>> named;  // every resource id, where it stands
   for (std::size_t i = 0; i < c.stations.size(); ++i) {
     const YAML::Node node = i < station_nodes.size() ? station_nodes[i] : root;

@@ -2,6 +2,7 @@
 // A cell's deployment file (deploy/cells/*.yaml) and the processes it starts.
 
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
@@ -31,6 +32,15 @@ struct BufferConfig {
   std::map<std::string, int> stock;
 };
 
+// `restart: {limit: 5, window: 60}`: cellctl up restarts a cell process that ends, and gives
+// up (stops the cell) when one ended more than `limit` times within `window` seconds.
+struct RestartPolicy {
+  int limit = 5;
+  std::chrono::seconds window{60};
+  std::chrono::milliseconds first_backoff{500};  // doubled with each end inside the window
+  std::chrono::milliseconds max_backoff{8000};
+};
+
 struct CellConfig {
   std::filesystem::path file;
   int domain = 42;
@@ -43,6 +53,7 @@ struct CellConfig {
   // The box every commanded position must lie in (cell-sim and the arms refuse others):
   // `bounds: {min: [x, y, z], max: [x, y, z]}`, or the layout's box with a margin.
   Point bounds_min{}, bounds_max{};
+  RestartPolicy restart;
 
   std::vector<std::string> resource_ids() const;
 };

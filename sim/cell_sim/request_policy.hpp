@@ -30,6 +30,11 @@ class RequestPolicy {
   void hired(const std::string& resource, const std::string& order) { hired_[resource].insert(order); }
   void spawned(const std::string& body, const std::string& requester) { owner_[body] = requester; }
   void removed(const std::string& body) { owner_.erase(body); }
+  // Who spawned the body ("" when no one did).
+  std::string owner_of(const std::string& body) const {
+    const auto it = owner_.find(body);
+    return it == owner_.end() ? "" : it->second;
+  }
   // The order is over: it hires no one any more; returns the bodies it owned, now forgotten.
   std::vector<std::string> order_ended(const std::string& order);
 

@@ -59,6 +59,9 @@ void WorldBlock::handle(const fb::Data& d) {
     const std::string& kind = fb::get<std::string>(d, "kind");
     const std::string& id = fb::get<std::string>(d, "body_id");
     if (kind == "spawn") {
+      // A requester's own body spawned again (a resource that restarted: its table, its
+      // gripper, its base) is replaced.
+      if (world_.pose(id) && policy_.owner_of(id) == fb::get<std::string>(d, "requester")) world_.remove(id);
       const fb::Numbers& h = fb::get<fb::Numbers>(d, "half_extents");
       world_.spawn({id, fb::get_or<std::string>(d, "mesh_uri", ""), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
                     pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get_or<bool>(d, "is_static", false),

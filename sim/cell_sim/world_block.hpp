@@ -1,6 +1,7 @@
 #pragma once
 // cell-sim's function block: requests change the world at once and are answered at once
-// (a "ping" changes nothing and is answered too);
+// (a "ping" changes nothing and is answered too; a spawn of a body its requester has
+// already replaces it: a resource that restarted spawns its bodies again);
 // a move in the physical cell is answered when the sim clock reaches its end (or its first
 // collision), a move in a virtual scene at once (virtual assembly is a check). TICK
 // (from the process's loop) advances the clock and publishes what is due.

@@ -103,9 +103,9 @@ TEST_CASE("mobile robot: a buffer that refuses fails the fetch with its reason",
 
 TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the first collision", "[sim][world]") {
   sim::SimWorld world;
-  world.spawn({"table", "", Eigen::Vector3d(1, 0.025, 1), sim::Pose(Eigen::Translation3d(0, -0.025, 0)), true});
-  world.spawn({"pad", "", Eigen::Vector3d(0.01, 0.01, 0.01), sim::Pose(Eigen::Translation3d(0, 0.5, 0)), false});
-  world.spawn({"box", "", Eigen::Vector3d(0.02, 0.02, 0.02), sim::Pose(Eigen::Translation3d(0, 0.47, 0)), false});
+  world.spawn({"table", "", Eigen::Vector3d(1, 0.025, 1), sim::Pose(Eigen::Translation3d(0, -0.025, 0)), true, "", false});
+  world.spawn({"pad", "", Eigen::Vector3d(0.01, 0.01, 0.01), sim::Pose(Eigen::Translation3d(0, 0.5, 0)), false, "", false});
+  world.spawn({"box", "", Eigen::Vector3d(0.02, 0.02, 0.02), sim::Pose(Eigen::Translation3d(0, 0.47, 0)), false, "", false});
 
   const sim::MoveResult free = world.move({"pad", {"box"}, {sim::Pose(Eigen::Translation3d(0.3, 0.5, 0.4))}, 0.25, 1});
   CHECK_FALSE(free.collided);
@@ -122,7 +122,7 @@ TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the fi
   CHECK(hit.duration == Approx(hit.distance / 0.25));
 
   CHECK_THROWS_AS(world.move({"table", {}, {sim::Pose::Identity()}, 1, 1}), sim::SimError);
-  CHECK_THROWS_AS(world.spawn({"pad", "", Eigen::Vector3d::Zero(), sim::Pose::Identity(), false}), sim::SimError);
+  CHECK_THROWS_AS(world.spawn({"pad", "", Eigen::Vector3d::Zero(), sim::Pose::Identity(), false, "", false}), sim::SimError);
   world.set_static("box", true);
   CHECK(world.is_static("box"));
 }

@@ -70,3 +70,19 @@ inline std::vector<std::pair<std::string, pid_t>> children_of(pid_t parent) {
 }
 
 }  // namespace test
+
+namespace test {
+
+// The child of `parent` whose command line has `argument` (a resource id), or 0.
+inline pid_t child_with_argument(pid_t parent, const std::string& argument) {
+  for (const auto& [name, pid] : children_of(parent)) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline", std::ios::binary);
+    std::string arg;
+    while (std::getline(in, arg, '\0')) {
+      if (arg == argument) return pid;
+    }
+  }
+  return 0;
+}
+
+}  // namespace test

@@ -1,0 +1,84 @@
+#include "deploy/cellctl/supervisor.hpp"
+
+#include <algorithm>
+
+namespace cellctl {
+
+Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, std::function<void(const std::string&)> log)
+    : policy_(policy), log_(std::move(log)) {
+  for (auto& spec : specs) {
+    Child child{std::move(spec), nullptr, {}, {}, 0};
+    child.process = std::make_unique<Process>(child.spec.name, child.spec.argv);
+    children_.push_back(std::move(child));
+  }
+}
+
+Supervisor::~Supervisor() { stop(); }
+
+std::string Supervisor::tend() {
+  const auto now = std::chrono::steady_clock::now();
+  for (Child& c : children_) {
+    if (c.process) {
+      const int code = c.process->poll();
+      if (code < 0) continue;
+      c.process.reset();
+      c.ends.push_back(now);
+      while (!c.ends.empty() && now - c.ends.front() > policy_.window) c.ends.pop_front();
+      if (static_cast<int>(c.ends.size()) > policy_.limit) {
+        return c.spec.name + " ended " + std::to_string(c.ends.size()) + " times within " +
+               std::to_string(policy_.window.count()) + " s, last with exit " + std::to_string(code);
+      }
+      // Backoff doubles with each end inside the window: a process that dies at once again
+      // is not restarted in a tight loop.
+      auto backoff = policy_.first_backoff * (1 << std::min<int>(static_cast<int>(c.ends.size()) - 1, 10));
+      backoff = std::min(backoff, policy_.max_backoff);
+      c.restart_at = now + backoff;
+      log_(c.spec.name + " ended (exit " + std::to_string(code) + "); restarting it in " +
+           std::to_string(backoff.count()) + " ms");
+    } else if (now >= c.restart_at) {
+      try {
+        c.process = std::make_unique<Process>(c.spec.name, c.spec.argv);
+        ++c.restarts;
+        log_(c.spec.name + " restarted (pid " + std::to_string(c.process->pid()) + ", restart " +
+             std::to_string(c.restarts) + ")");
+      } catch (const std::exception& e) {
+        return c.spec.name + " cannot be started again: " + e.what();
+      }
+    }
+  }
+  return "";
+}
+
+int Supervisor::restarts(const std::string& name) const {
+  for (const Child& c : children_) {
+    if (c.spec.name == name) return c.restarts;
+  }
+  return 0;
+}
+
+std::vector<std::pair<std::string, long>> Supervisor::peak_rss() const {
+  std::vector<std::pair<std::string, long>> out;
+  for (const Child& c : children_) {
+    if (c.process) out.emplace_back(c.spec.name, c.process->peak_rss_kb());
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, pid_t>> Supervisor::pids() const {
+  std::vector<std::pair<std::string, pid_t>> out;
+  for (const Child& c : children_) {
+    if (c.process) out.emplace_back(c.spec.name, c.process->pid());
+  }
+  return out;
+}
+
+void Supervisor::stop() {
+  std::vector<Process*> all;
+  for (Child& c : children_) {
+    if (c.process) all.push_back(c.process.get());
+  }
+  stop_all(all);
+  for (Child& c : children_) c.process.reset();
+}
+
+}  // namespace cellctl

@@ -1,0 +1,47 @@
+#pragma once
+// Keeps a cell's processes running, as systemd's Restart=on-failure or ROS 2 launch's
+// respawn do: a process that ends is started again with the same arguments after a backoff
+// (0.5 s, doubling up to 8 s). A process that ends more than `limit` times within `window`
+// is given up on: the cell cannot heal itself, and the operator is told why.
+
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/processes.hpp"
+
+namespace cellctl {
+
+class Supervisor {
+ public:
+  // Starts every process of the specs, in order.
+  Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, std::function<void(const std::string&)> log);
+  ~Supervisor();
+
+  // Restarts what ended and is due; returns "" while the cell can go on, otherwise why not
+  // ("buffer-1 ended 6 times within 60 s, last with exit 134").
+  std::string tend();
+  int restarts(const std::string& name) const;
+  std::vector<std::pair<std::string, long>> peak_rss() const;
+  std::vector<std::pair<std::string, pid_t>> pids() const;
+  void stop();
+
+ private:
+  struct Child {
+    ProcessSpec spec;
+    std::unique_ptr<Process> process;  // null while it waits for its restart
+    std::deque<std::chrono::steady_clock::time_point> ends;
+    std::chrono::steady_clock::time_point restart_at;
+    int restarts = 0;
+  };
+  RestartPolicy policy_;
+  std::function<void(const std::string&)> log_;
+  std::vector<Child> children_;
+};
+
+}  // namespace cellctl

@@ -1,0 +1,64 @@
+// cellctl up as a supervisor: a cell process that dies is started again and the cell goes
+// on; one that keeps dying is given up on, and the cell stops with the reason.
+
+#include <signal.h>
+
+#include <catch2/catch.hpp>
+
+#include "tests/support/cell_test.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+// Waits until the text shows up in the file.
+bool appears(const fs::path& file, const std::string& text, std::chrono::seconds timeout = 30s) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (test::read_text(file).find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(50ms);
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("cellctl up restarts a process that dies, and gives up on one that keeps dying", "[process][cell]") {
+  const fs::path dir = test::scratch("supervision");
+  // The default cell on a domain of its own, allowed two restarts of a process a minute.
+  const fs::path cell = dir / "cell.yaml";
+  std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nrestart: {limit: 2, window: 60}\n";
+  const std::string domain = "220";
+  const fs::path log = dir / "up.log";
+  test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain}, log.string());
+  REQUIRE(appears(log, "cell up on domain"));
+
+  // buffer-2 (the Lego bricks) dies hard: it is back, and a Lego order is assembled.
+  const pid_t first = test::child_with_argument(up.pid(), "buffer-2");
+  REQUIRE(first > 0);
+  ::kill(first, SIGKILL);
+  REQUIRE(appears(log, "buffer-2 ended (exit 137); restarting it in 500 ms"));
+  REQUIRE(appears(log, "buffer-2 restarted"));
+  const int order = test::cellctl({"submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
+                                   domain, "--order", "after-restart", "--out", (dir / "after-restart").string()},
+                                  dir / "order.log");
+  INFO(test::read_text(dir / "order.log") << test::read_text(log));
+  CHECK(order == 0);
+
+  // Twice more within the minute: the third end is one too many.
+  for (int kill = 2; kill <= 3; ++kill) {
+    pid_t pid = 0;
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while ((pid = test::child_with_argument(up.pid(), "buffer-2")) == 0 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(50ms);
+    }
+    REQUIRE(pid > 0);
+    ::kill(pid, SIGKILL);
+    if (kill == 2) REQUIRE(appears(log, "restart 2)"));
+  }
+  CHECK(up.wait_for_exit(30s) == 1);
+  CHECK(test::read_text(log).find("error: buffer-2 ended 3 times within 60 s, last with exit 137; stopping the cell") !=
+        std::string::npos);
+  CHECK(test::children_of(up.pid()).empty());
+}
