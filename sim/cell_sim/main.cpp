@@ -15,6 +15,7 @@
 #include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "sim/cell_sim/world_block.hpp"
+#include "capabilitiesPubSubTypes.h"
 #include "negotiationPubSubTypes.h"
 #include "simulationPubSubTypes.h"
 #include "services/node/run.hpp"
@@ -77,6 +78,18 @@ int main(int argc, char** argv) {
     resource.connect("requests", "IND", "world", "REQUEST");
     resource.connect("world", "REPLY", "replies", "REQ");
     resource.connect("world", "CLOCK", "clock", "REQ");
+    // Its own line in the cell's status: requests it refused, and the last one's requester and reason.
+    resource.add(std::make_unique<dds::PublishBlock<cell::Capability, cell::CapabilityPubSubType>>(
+        "status", participant, "cell/capabilities", dds::TopicKind::state, [](const fb::Data& d) {
+          cell::Capability c;
+          c.resource_id("cell-sim");
+          c.kind("simulation");
+          c.refused_commands(static_cast<int32_t>(fb::get_or<std::int64_t>(d, "refused", 0)));
+          c.last_refusal(fb::get_or<std::string>(d, "last_refusal", "").substr(0, cell::Text::max_size - 1));
+          return c;
+        }));
+    resource.connect("world", "REFUSED", "status", "REQ");
+    resource.post("status", "REQ");
     requests.start();
     hires.start();
     orders.start();

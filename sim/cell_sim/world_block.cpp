@@ -30,6 +30,7 @@ WorldBlock::WorldBlock(std::string name, double real_time_factor, fb::CellBounds
   declare_input("HIRED", {"resource_id", "order_id"});
   declare_output("REPLY", {"request_id", "requester", "ok", "error", "collided", "start_time", "end_time"});
   declare_output("CLOCK", {"sim_time", "real_time_factor"});
+  declare_output("REFUSED", {"refused", "last_refusal"});
 }
 
 double WorldBlock::now() const {
@@ -55,7 +56,12 @@ void WorldBlock::handle(const fb::Data& d) {
                  {"start_time", start}, {"end_time", start}};
   double due = start;
   try {
-    if (const std::string problem = policy_.problem_with(d, world_); !problem.empty()) throw SimError(problem);
+    if (const std::string problem = policy_.problem_with(d, world_); !problem.empty()) {
+      emit("REFUSED", {{"refused", std::int64_t(++refused_)},
+                       {"last_refusal", fb::get<std::string>(d, "requester") + " " +
+                                            fb::get<std::string>(d, "request_id") + ": " + problem}});
+      throw SimError(problem);
+    }
     const std::string& kind = fb::get<std::string>(d, "kind");
     const std::string& id = fb::get<std::string>(d, "body_id");
     if (kind == "spawn") {

@@ -9,6 +9,8 @@
 //   inputs                          outputs
 //   REQUEST (SimRequest fields)     REPLY (SimReply fields)
 //   TICK                            CLOCK (sim_time, real_time_factor), every clock_period
+//                                   REFUSED (refused: how many so far, last_refusal: whose
+//                                   request and why), for the cell's status
 //   ORDER_ENDED (order_id): the bodies that order spawned leave the world (a twin that died
 //   leaves nothing behind for the next order)
 //   HIRED (resource_id, order_id): the resource confirmed an award to the order, so it may
@@ -44,6 +46,7 @@ class WorldBlock : public fb::FunctionBlock {
   std::chrono::steady_clock::time_point last_clock_{};
   std::multimap<double, fb::Data> pending_;  // replies by the sim time they are due
   RequestPolicy policy_;
+  std::size_t refused_ = 0;
 };
 
 }  // namespace sim

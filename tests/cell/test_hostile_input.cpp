@@ -155,7 +155,11 @@ class HostileCell {
     return "";
   }
   // Inside wait()'s predicate, which holds the lock.
-  const cell::Capability& capability_unlocked(const std::string& id) const { return capability_.at(id); }
+  const cell::Capability& capability_unlocked(const std::string& id) const {
+    static const cell::Capability none;
+    const auto it = capability_.find(id);
+    return it == capability_.end() ? none : it->second;
+  }
 
   template <class Pred>
   bool wait(std::chrono::milliseconds timeout, Pred pred) {
@@ -437,6 +441,12 @@ TEST_CASE("hostile: cell-sim refuses an intruder's changes to an order's parts, 
   table.kind("remove");
   table.body_id("station-1/table");
   CHECK(cell.ask_sim(table) == "station-1/table is a fixture of the cell");
+  // cell-sim's line in the cell's status says so.
+  CHECK(cell.wait(10s, [&] {
+    const cell::Capability& sim = cell.capability_unlocked("cell-sim");
+    return sim.refused_commands() >= 4 &&
+           sim.last_refusal().to_string().find(": station-1/table is a fixture of the cell") != std::string::npos;
+  }));
   const int code = ok1->wait_for_exit(120s);
   INFO(test::read_text(cell.dir() / "ok1.log"));
   CHECK(code == 0);
