@@ -53,6 +53,25 @@ fs::path pid_file(int domain) {
   return fs::path(tmp ? tmp : "/tmp") / ("agile-cell-" + std::to_string(domain) + ".pid");
 }
 
+// The pid of the `cellctl up` that runs the cell on the domain, or 0. A pid file left by an
+// up that was killed (its processes ended with it) is stale: `stale` says so, and it goes,
+// so that no other process that got the same pid is ever signalled.
+pid_t running_up(int domain, bool& stale) {
+  stale = false;
+  const fs::path file = pid_file(domain);
+  pid_t pid = 0;
+  if (!(std::ifstream(file) >> pid) || pid <= 0) return 0;
+  std::ifstream cmdline("/proc/" + std::to_string(pid) + "/cmdline", std::ios::binary);
+  std::vector<std::string> args;
+  for (std::string arg; std::getline(cmdline, arg, '\0');) args.push_back(arg);
+  const bool is_up = !args.empty() && fs::path(args[0]).filename() == "cellctl" &&
+                     std::find(args.begin(), args.end(), "up") != args.end();
+  if (is_up) return pid;
+  stale = true;
+  fs::remove(file);
+  return 0;
+}
+
 // The cell's processes, started in order; cell-sim first, as the others wait for it.
 class RunningCell {
  public:
@@ -227,14 +246,21 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     const CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
+    bool stale = false;
+    if (const pid_t other = running_up(cell.domain, stale)) {
+      throw std::runtime_error("a cell runs on domain " + std::to_string(cell.domain) + " already (cellctl up, pid " +
+                               std::to_string(other) + "); `cellctl down --domain " + std::to_string(cell.domain) +
+                               "` stops it");
+    }
+    if (stale) std::cerr << "cellctl up: the last cellctl up on this domain was killed; starting the cell afresh\n";
     CellObserver observer(cell.domain, cell.localhost_only);
     Supervisor supervisor(cell_processes(cell, executable_dir()), cell.restart,
                           [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; });
-    const auto missing = observer.wait_for_resources(cell.resource_ids(), std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
-    if (!missing.empty()) {
+    const auto wait = std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000));
+    if (const auto missing = observer.wait_for_resources(cell.resource_ids(), wait); !missing.empty()) {
       std::string list;
       for (const auto& m : missing) list += " " + m;
-      throw std::runtime_error("the cell did not come up within " + std::to_string(static_cast<int>(cell_options->wait_s)) +
+      throw std::runtime_error("the cell did not come up within " + std::to_string(wait.count() / 1000) +
                                " s; missing:" + list);
     }
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n';
@@ -299,9 +325,13 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   down->callback([cell_options, &exit_code] {
     const CellConfig cell = cell_options->load();
     const fs::path file = pid_file(cell.domain);
-    pid_t pid = 0;
-    if (!(std::ifstream(file) >> pid) || pid <= 0) {
-      std::cerr << "error: no cell of cellctl up on domain " << cell.domain << " (" << file.string() << ")\n";
+    bool stale = false;
+    const pid_t pid = running_up(cell.domain, stale);
+    if (pid == 0) {
+      std::cerr << "error: no cell of cellctl up on domain " << cell.domain << " (" << file.string()
+                << (stale ? ": its cellctl up was killed, and its processes ended with it; the stale file is removed"
+                          : "")
+                << ")\n";
       exit_code = 1;
       return;
     }

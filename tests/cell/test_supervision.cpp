@@ -62,3 +62,37 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
         std::string::npos);
   CHECK(test::children_of(up.pid()).empty());
 }
+
+TEST_CASE("cellctl up: one cell per domain; after an up that was killed, down says so and up starts afresh",
+          "[process][cell]") {
+  const fs::path dir = test::scratch("up-killed");
+  const std::string domain = "221";
+  const fs::path log = dir / "up.log";
+  auto up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain},
+                                                 log.string());
+  REQUIRE(appears(log, "cell up on domain"));
+  CHECK(test::cellctl({"up", "--domain", domain}, dir / "second.log", 30s) == 1);
+  CHECK(test::read_text(dir / "second.log").find("a cell runs on domain 221 already") != std::string::npos);
+
+  // cellctl up dies hard: its processes end with it (they asked for SIGTERM when their parent goes).
+  const auto children = test::children_of(up->pid());
+  REQUIRE(children.size() == 5);
+  up->kill_hard();
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  const auto any_left = [&] {
+    for (const auto& [name, pid] : children) {
+      if (fs::exists("/proc/" + std::to_string(pid))) return true;
+    }
+    return false;
+  };
+  while (any_left() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+  CHECK_FALSE(any_left());
+
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 1);
+  CHECK(test::read_text(dir / "down.log").find("its cellctl up was killed") != std::string::npos);
+  up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain},
+                                            (dir / "again.log").string());
+  REQUIRE(appears(dir / "again.log", "cell up on domain"));
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down2.log", 30s) == 0);
+  CHECK(up->wait_for_exit(20s) == 0);
+}
