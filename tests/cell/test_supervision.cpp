@@ -63,7 +63,7 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
   CHECK(test::children_of(up.pid()).empty());
 }
 
-TEST_CASE("cellctl up: one cell per domain; after an up that was killed, down says so and up starts afresh",
+TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, down says so and up starts afresh",
           "[process][cell]") {
   const fs::path dir = test::scratch("up-killed");
   const std::string domain = "221";
