@@ -294,15 +294,19 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
 
 ResourceNode::~ResourceNode() { impl_->resource.on_idle({}); }
 
-void ResourceNode::start(std::chrono::milliseconds wait_for_sim) {
+void ResourceNode::start(std::chrono::milliseconds wait_for_sim, const std::atomic<bool>* running) {
   Impl& n = *impl_;
+  const auto stopped = [running] { return running && !*running; };
   const auto gone = [&] {
     return std::runtime_error("cell-sim did not answer within " + std::to_string(wait_for_sim.count() / 1000) +
                               " s on this domain");
   };
   // Requests are events, lost if nobody listens yet: a device that moves things needs cell-sim.
   const auto deadline = std::chrono::steady_clock::now() + wait_for_sim;
-  if (n.sim_requests && !n.sim_requests->writer().wait_for_readers(1, wait_for_sim)) throw gone();
+  while (n.sim_requests && !n.sim_requests->writer().wait_for_readers(1, std::chrono::milliseconds(100))) {
+    if (stopped()) return;
+    if (std::chrono::steady_clock::now() > deadline) throw gone();
+  }
   publish_capability();
   for (auto& start : n.starters) start();
   if (!n.sim_requests) return;
@@ -311,6 +315,7 @@ void ResourceNode::start(std::chrono::milliseconds wait_for_sim) {
   // answers, on this thread, before the resource's own thread runs.
   fb::SimRequests pings(n.config.id + "/node");
   for (int round = 0; !n.sim_answers; ++round) {
+    if (stopped()) return;
     if (std::chrono::steady_clock::now() > deadline) throw gone();
     if (round % 10 == 0) {
       const fb::Data ping = pings.ping();

@@ -16,6 +16,7 @@
 // A device block is any DeviceBlock; the node adds no product knowledge.
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -59,8 +60,11 @@ class ResourceNode {
 
   // Starts listening to the topics; call once everything is wired, before the resource's
   // thread runs. A device that moves things first waits until cell-sim answers a ping
-  // (requests and replies both get through); throws std::runtime_error if it does not.
-  void start(std::chrono::milliseconds wait_for_sim = std::chrono::seconds(30));
+  // (requests and replies both get through); throws std::runtime_error if it does not. It
+  // stops waiting when `running` (the process's flag, set false by SIGTERM) turns false: a
+  // process told to stop while cell-sim is gone ends at once, not after the wait.
+  void start(std::chrono::milliseconds wait_for_sim = std::chrono::seconds(30),
+             const std::atomic<bool>* running = nullptr);
   dds::SimClock& clock();
   void publish_capability();
 

@@ -80,8 +80,8 @@ int main(int argc, char** argv) {
     };
     services::ResourceNode station_node(station_resource, participant, station, station_block, hold);
     services::ResourceNode arm_node(arm_resource, participant, arm, arm_block, hold_arm);
-    station_node.start();
-    arm_node.start();
+    station_node.start(std::chrono::seconds(30), &running);
+    arm_node.start(std::chrono::seconds(30), &running);
     station_resource.post("station", "INIT");
     std::cout << "station " << station.id << " with arm " << arm.id << " ready on domain " << dds.domain_id
               << std::endl;

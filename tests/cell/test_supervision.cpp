@@ -81,12 +81,15 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   const auto any_left = [&] {
     for (const auto& [name, pid] : children) {
-      if (fs::exists("/proc/" + std::to_string(pid))) return true;
+      if (test::is_running(pid)) return true;
     }
     return false;
   };
   while (any_left() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
-  CHECK_FALSE(any_left());
+  for (const auto& [name, pid] : children) {
+    INFO(name << " (pid " << pid << ") still runs: " << test::read_text("/proc/" + std::to_string(pid) + "/stat"));
+    CHECK_FALSE(test::is_running(pid));
+  }
 
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 1);
   CHECK(test::read_text(dir / "down.log").find("its cellctl up was killed") != std::string::npos);

@@ -38,6 +38,16 @@ inline int cellctl(std::vector<std::string> args, const std::filesystem::path& l
   return p.wait_for_exit(timeout);
 }
 
+// Whether the process runs: it exists and is not a zombie (an orphan that ended waits to be
+// reaped by whoever adopted it).
+inline bool is_running(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto close = line.rfind(')');
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
+}
+
 // VmRSS of a process in kB, 0 when it is gone.
 inline long rss_kb(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/status");
