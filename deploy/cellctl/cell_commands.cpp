@@ -72,6 +72,16 @@ pid_t running_up(int domain, bool& stale) {
   return 0;
 }
 
+// Until every resource of the file has published its capability; throws naming the missing.
+void wait_for_cell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait) {
+  const auto missing = observer.wait_for_resources(cell.resource_ids(), wait);
+  if (missing.empty()) return;
+  std::string list;
+  for (const auto& m : missing) list += " " + m;
+  throw std::runtime_error("the cell did not come up within " + std::to_string(wait.count() / 1000) +
+                           " s; missing:" + list);
+}
+
 // The cell's processes, started in order; cell-sim first, as the others wait for it.
 class RunningCell {
  public:
@@ -79,13 +89,7 @@ class RunningCell {
     for (const auto& spec : cell_processes(cell, executable_dir())) {
       processes_.push_back(std::make_unique<Process>(spec.name, spec.argv));
     }
-    const auto missing = observer.wait_for_resources(cell.resource_ids(), wait);
-    if (!missing.empty()) {
-      std::string list;
-      for (const auto& m : missing) list += " " + m;
-      throw std::runtime_error("the cell did not come up within " + std::to_string(wait.count() / 1000) +
-                               " s; missing:" + list);
-    }
+    wait_for_cell(cell, observer, wait);
   }
   ~RunningCell() { stop(); }
 
@@ -256,13 +260,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     CellObserver observer(cell.domain, cell.localhost_only);
     Supervisor supervisor(cell_processes(cell, executable_dir()), cell.restart,
                           [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; });
-    const auto wait = std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000));
-    if (const auto missing = observer.wait_for_resources(cell.resource_ids(), wait); !missing.empty()) {
-      std::string list;
-      for (const auto& m : missing) list += " " + m;
-      throw std::runtime_error("the cell did not come up within " + std::to_string(wait.count() / 1000) +
-                               " s; missing:" + list);
-    }
+    wait_for_cell(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n';
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size()
               << " resources); `cellctl down --domain " << cell.domain << "` stops it" << std::endl;

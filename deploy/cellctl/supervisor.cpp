@@ -49,29 +49,6 @@ std::string Supervisor::tend() {
   return "";
 }
 
-int Supervisor::restarts(const std::string& name) const {
-  for (const Child& c : children_) {
-    if (c.spec.name == name) return c.restarts;
-  }
-  return 0;
-}
-
-std::vector<std::pair<std::string, long>> Supervisor::peak_rss() const {
-  std::vector<std::pair<std::string, long>> out;
-  for (const Child& c : children_) {
-    if (c.process) out.emplace_back(c.spec.name, c.process->peak_rss_kb());
-  }
-  return out;
-}
-
-std::vector<std::pair<std::string, pid_t>> Supervisor::pids() const {
-  std::vector<std::pair<std::string, pid_t>> out;
-  for (const Child& c : children_) {
-    if (c.process) out.emplace_back(c.spec.name, c.process->pid());
-  }
-  return out;
-}
-
 void Supervisor::stop() {
   std::vector<Process*> all;
   for (Child& c : children_) {

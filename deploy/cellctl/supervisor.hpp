@@ -7,7 +7,6 @@
 #include <chrono>
 #include <deque>
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,9 +25,6 @@ class Supervisor {
   // Restarts what ended and is due; returns "" while the cell can go on, otherwise why not
   // ("buffer-1 ended 6 times within 60 s, last with exit 134").
   std::string tend();
-  int restarts(const std::string& name) const;
-  std::vector<std::pair<std::string, long>> peak_rss() const;
-  std::vector<std::pair<std::string, pid_t>> pids() const;
   void stop();
 
  private:
