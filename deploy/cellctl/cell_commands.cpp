@@ -15,9 +15,12 @@
 
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
+#include "deploy/cellctl/cell_status.hpp"
+#include "deploy/cellctl/order_desk.hpp"
 #include "deploy/cellctl/processes.hpp"
 #include "deploy/cellctl/supervisor.hpp"
 #include "deploy/cellctl/text_table.hpp"
+#include "services/state/cell_store.hpp"
 
 namespace cellctl {
 namespace {
@@ -33,19 +36,16 @@ struct CellOptions {
   int domain = -1;  // -1: the file's
   double real_time_factor = 0;
   double wait_s = 30;
+  std::string state_dir;
 
-  CellConfig load() const {
-    CellConfig c = read_cell_config(cell);
-    if (domain >= 0) c.domain = domain;
-    if (real_time_factor > 0) c.real_time_factor = real_time_factor;
-    return c;
-  }
+  CellConfig load() const;
 };
 
 void add_cell_options(CLI::App* cmd, CellOptions& o) {
   cmd->add_option("--cell", o.cell, "Deployment file of the cell")->check(CLI::ExistingFile);
   cmd->add_option("--domain", o.domain, "DDS domain id, instead of the file's")->check(CLI::Range(0, 232));
   cmd->add_option("--real-time-factor", o.real_time_factor, "Instead of the file's")->check(CLI::PositiveNumber);
+  cmd->add_option("--state-dir", o.state_dir, "Folder of the cell's database, instead of the file's state_dir");
 }
 
 fs::path pid_file(int domain) {
@@ -53,23 +53,53 @@ fs::path pid_file(int domain) {
   return fs::path(tmp ? tmp : "/tmp") / ("agile-cell-" + std::to_string(domain) + ".pid");
 }
 
+bool is_cellctl_up(pid_t pid) {
+  std::ifstream cmdline("/proc/" + std::to_string(pid) + "/cmdline", std::ios::binary);
+  std::vector<std::string> args;
+  for (std::string arg; std::getline(cmdline, arg, '\0');) args.push_back(arg);
+  return !args.empty() && fs::path(args[0]).filename() == "cellctl" &&
+         std::find(args.begin(), args.end(), "up") != args.end();
+}
+
+// The pid file's pid and the state folder of the cell.
+std::pair<pid_t, std::string> read_pid_file(int domain) {
+  std::ifstream file(pid_file(domain));
+  pid_t pid = 0;
+  std::string dir;
+  if (!(file >> pid) || pid <= 0) return {0, ""};
+  file >> std::ws;
+  std::getline(file, dir);
+  return {pid, dir};
+}
+
 // The pid of the `cellctl up` that runs the cell on the domain, or 0. A pid file left by an
 // up that was killed (its processes ended with it) is stale: `stale` says so, and it goes,
 // so that no other process that got the same pid is ever signalled.
 pid_t running_up(int domain, bool& stale) {
-  stale = false;
-  const fs::path file = pid_file(domain);
-  pid_t pid = 0;
-  if (!(std::ifstream(file) >> pid) || pid <= 0) return 0;
-  std::ifstream cmdline("/proc/" + std::to_string(pid) + "/cmdline", std::ios::binary);
-  std::vector<std::string> args;
-  for (std::string arg; std::getline(cmdline, arg, '\0');) args.push_back(arg);
-  const bool is_up = !args.empty() && fs::path(args[0]).filename() == "cellctl" &&
-                     std::find(args.begin(), args.end(), "up") != args.end();
-  if (is_up) return pid;
-  stale = true;
-  fs::remove(file);
-  return 0;
+  const pid_t pid = read_pid_file(domain).first;
+  stale = pid > 0 && !is_cellctl_up(pid);
+  if (stale) fs::remove(pid_file(domain));
+  return stale ? 0 : pid;
+}
+
+// The state folder of the cell `cellctl up` runs on the domain, or "".
+std::string running_state_dir(int domain) {
+  const auto [pid, dir] = read_pid_file(domain);
+  return pid > 0 && is_cellctl_up(pid) ? dir : "";
+}
+
+// The state folder: --state-dir, else that of the cell running on the domain (submit and
+// status talk to it), else the file's.
+CellConfig CellOptions::load() const {
+  CellConfig c = read_cell_config(cell);
+  if (domain >= 0) c.domain = domain;
+  if (real_time_factor > 0) c.real_time_factor = real_time_factor;
+  if (!state_dir.empty()) {
+    c.state_dir = state_dir;
+  } else if (const std::string running = running_state_dir(c.domain); !running.empty()) {
+    c.state_dir = running;
+  }
+  return c;
 }
 
 // Until every resource of the file has published its capability; throws naming the missing.
@@ -185,11 +215,7 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
     if (ids.count(s.order_id().to_string())) print_progress(s);
   });
   for (auto& order : orders) {
-    std::vector<std::string> argv{executable_dir() + "/twin", "--domain", std::to_string(cell.domain), "--order", order.id,
-                                  "--product", order.product, "--out", order.out, "--sequence", o.sequence, "--path",
-                                  o.path, "--wait", std::to_string(wait_s), "--lease", std::to_string(cell.liveliness_lease),
-                                  "--quiet"};
-    if (!cell.localhost_only) argv.push_back("--all-interfaces");
+    const auto argv = twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence, o.path, wait_s);
     order.sim_start = observer.sim_now();
     order.twin = std::make_unique<Process>("twin-" + order.id, argv);
   }
@@ -211,6 +237,41 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   for (auto& order : orders) {
     const auto it = statuses.find(order.id);
     order.sim_end = it != statuses.end() ? it->second.sim_time() : observer.sim_now();
+  }
+}
+
+// Hands the order to the desk of the cell `cellctl up` runs (its database), and follows it to
+// its end: the twin's exit code (0 assembled, 1 failed, 2 a bad product description).
+int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& order, CellObserver& observer) {
+  state::CellStore store(cell.state_folder());
+  const std::string product = fs::absolute(order.product).string(), out = fs::absolute(order.out).string();
+  if (!store.submit_order({order.id, "", "", product, out, o.sequence, o.path})) {
+    for (const auto& known : store.orders()) {
+      if (known.order == order.id) {
+        std::cerr << "error: the cell has an order " << order.id << " already (" << known.state
+                  << "); give this one another id with --order\n";
+      }
+    }
+    return 1;
+  }
+  store.journal("cellctl", "submitted", order.id, product);
+  observer.on_status([id = order.id](const cell::OrderStatus& s) {
+    if (s.order_id().to_string() == id) print_progress(s);
+  });
+  for (;;) {
+    for (const auto& known : store.orders()) {
+      if (known.order != order.id || !known.ended() || known.exit_code < 0) continue;
+      observer.on_status({});
+      if (known.state == "DONE") std::cout << "order " << order.id << " done: " << out << "/plan.json, " << out << "/animation.gltf\n";
+      if (known.state == "FAILED") std::cerr << "error: order " << order.id << ": " << known.reason << '\n';
+      return known.exit_code;
+    }
+    if (stop_requested) {
+      observer.on_status({});
+      std::cout << "order " << order.id << " goes on in the cell; `cellctl status` follows it\n";
+      return 0;
+    }
+    std::this_thread::sleep_for(100ms);
   }
 }
 
@@ -258,13 +319,25 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     if (stale) std::cerr << "cellctl up: the last cellctl up on this domain was killed; starting the cell afresh\n";
     CellObserver observer(cell.domain, cell.localhost_only);
+    state::CellStore store(cell.state_folder());
+    store.journal("cellctl", "up", "", "domain " + std::to_string(cell.domain));
+    bool world_lost = false;  // cell-sim restarts: the twins' virtual scenes went with it
     Supervisor supervisor(cell_processes(cell, executable_dir()), cell.restart,
-                          [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; });
+                          [&](const std::string& process, const std::string& event, const std::string& what) {
+                            std::cerr << "cellctl up: " << what << std::endl;
+                            store.journal(process, event, "", what);
+                            world_lost |= event == "restarting all";
+                          });
     wait_for_cell(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
-    std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n';
-    std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size()
-              << " resources); `cellctl down --domain " << cell.domain << "` stops it" << std::endl;
+    std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n' << fs::absolute(cell.state_folder()).string() << '\n';
+    std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
+              << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"
+              << std::endl;
+    OrderDesk desk(cell, store, [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; });
     while (!stop_requested) {
+      if (world_lost) desk.interrupt_all();
+      world_lost = false;
+      desk.tend();
       if (const std::string why = supervisor.tend(); !why.empty()) {
         std::cerr << "error: " << why << "; stopping the cell. Look at that process's output above, fix the cause, "
                   << "and start the cell again\n";
@@ -273,12 +346,14 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       }
       std::this_thread::sleep_for(100ms);
     }
+    desk.interrupt_all();  // their orders are INTERRUPTED: the next up on this state takes them up
     supervisor.stop();
+    store.journal("cellctl", "down", "", exit_code == 0 ? "" : "gave up");
     fs::remove(pid_file(cell.domain));
     std::cout << "cell down" << std::endl;
   });
 
-  CLI::App* submit_cmd = app.add_subcommand("submit", "Spawn a twin for an order and follow it to its end");
+  CLI::App* submit_cmd = app.add_subcommand("submit", "Hand an order to the cell of cellctl up on the domain (or, with none, run its twin here) and follow it to its end");
   add_cell_options(submit_cmd, *cell_options);
   add_submit_options(submit_cmd, *submit_options, false);
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
@@ -286,6 +361,11 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::signal(SIGINT, request_stop);
     CellObserver observer(cell.domain, cell.localhost_only);
     auto orders = orders_of(*submit_options);
+    if (!running_state_dir(cell.domain).empty()) {
+      exit_code = submit_to_desk(cell, *submit_options, orders.front(), observer);
+      return;
+    }
+    // No cellctl up on the domain (a cell of processes started by hand): the twin runs here.
     run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
     const Order& order = orders.front();
     std::cout << "twin peak RSS " << order.peak_rss_kb / 1024 << " MB\n";
@@ -293,13 +373,20 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     exit_code = order.exit_code;
   });
 
-  CLI::App* status = app.add_subcommand("status", "List the cell's resources and orders");
+  CLI::App* status = app.add_subcommand("status", "List the cell's resources, inventory and orders");
   add_cell_options(status, *cell_options);
-  status->callback([cell_options] {
+  auto json = std::make_shared<bool>(false);
+  status->add_flag("--json", *json, "As one JSON object (docs/cli.md gives its shape)");
+  status->callback([cell_options, json] {
     const CellConfig cell = cell_options->load();
     CellObserver observer(cell.domain, cell.localhost_only);
     observer.wait_for_resources(cell.resource_ids(), 2s);
     std::this_thread::sleep_for(300ms);  // orders and resources outside the file
+    const nlohmann::json report = cell_status(cell, observer);
+    if (*json) {
+      std::cout << report.dump(2) << std::endl;
+      return;
+    }
     TextTable resources({"resource", "kind", "state", "work", "queued", "reserved by", "waiting", "stock", "refused"});
     for (const auto& [id, r] : observer.resources()) {
       std::string stock, waiting;
@@ -313,6 +400,13 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     std::cout << "Cell on domain " << cell.domain << ": " << observer.resources().size() << " resources\n\n";
     resources.print(std::cout);
+    TextTable inventory({"part type", "initial", "in buffers", "assembled", "on stations", "in transit", "inspection", ""});
+    for (const auto& [type, c] : report["inventory"].items()) {
+      inventory.add_row({type, c["initial"].dump(), c["in_buffers"].dump(), c["assembled"].dump(), c["on_stations"].dump(),
+                         c["in_transit"].dump(), c["inspection"].dump(), c["conserved"] ? "" : "NOT CONSERVED"});
+    }
+    std::cout << "\nInventory (" << report["state_dir"].get<std::string>() << ")\n";
+    inventory.print(std::cout);
     const auto orders = observer.orders();
     std::cout << "\n" << orders.size() << " orders\n";
     for (const auto& [id, s] : orders) print_progress(s);
@@ -349,7 +443,12 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   add_submit_options(run, *submit_options, true);
   run->add_option("--events", *events, "Write every command event and delivery as JSON lines to this file");
   run->callback([cell_options, submit_options, events, &exit_code] {
-    const CellConfig cell = cell_options->load();
+    CellConfig cell = cell_options->load();
+    if (cell.state_dir.empty()) {
+      // A run starts from the deployment file's stock: its state is its own, beside its output.
+      cell.state_dir = fs::absolute(submit_options->out.empty() ? "out" : submit_options->out) / "cell-state";
+      fs::remove_all(cell.state_dir);
+    }
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
     CellObserver observer(cell.domain, cell.localhost_only);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <set>
 
@@ -162,7 +163,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds", "restart"});
+              "mobile_robots", "buffers", "bounds", "restart", "state_dir"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -185,6 +186,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     buffer_nodes.push_back(b);
   }
   read_bounds(file, root, c);
+  if (root["state_dir"]) {
+    std::string dir;
+    read(file, root, "state_dir", dir);
+    if (dir.empty()) throw ConfigError(where(file, root["state_dir"]) + ": state_dir names a folder");
+    c.state_dir = file.parent_path() / dir;
+  }
   if (const YAML::Node restart = root["restart"]) {
     known_keys(file, restart, {"limit", "window"});
     long window = c.restart.window.count();
@@ -217,6 +224,27 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   return c;
 }
 
+std::filesystem::path CellConfig::state_folder() const {
+  if (!state_dir.empty()) return state_dir;
+  const char* xdg = std::getenv("XDG_STATE_HOME");
+  const char* home = std::getenv("HOME");
+  const std::filesystem::path base = xdg && *xdg ? std::filesystem::path(xdg)
+                                     : home && *home ? std::filesystem::path(home) / ".local" / "state"
+                                                     : std::filesystem::temp_directory_path();
+  return base / "agile-cell" / ("domain-" + std::to_string(domain));
+}
+
+std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::path& bin, const std::string& order,
+                                   const std::string& product, const std::string& out, const std::string& sequence,
+                                   const std::string& path, double wait_s) {
+  std::vector<std::string> argv{(bin / "twin").string(), "--domain", std::to_string(c.domain), "--order", order,
+                                "--product", product, "--out", out, "--sequence", sequence, "--path", path, "--wait",
+                                std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--state-dir",
+                                c.state_folder().string(), "--quiet"};
+  if (!c.localhost_only) argv.push_back("--all-interfaces");
+  return argv;
+}
+
 std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesystem::path& bin) {
   const std::string domain = std::to_string(c.domain), lease = std::to_string(c.liveliness_lease);
   std::vector<ProcessSpec> out;
@@ -229,6 +257,7 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
   out.push_back({"cell-sim", {(bin / "cell-sim").string(), "--domain", domain, "--real-time-factor",
                               std::to_string(c.real_time_factor)}});
   add_bounds(out.back().argv);
+  out.back().others_depend = true;
   for (const auto& st : c.stations) {
     ProcessSpec station{st.id, {(bin / "station").string(), "--domain", domain, "--id", st.id, "--arm-id", st.arm,
                                 "--arm-speed", std::to_string(st.arm_speed), "--arm-angular-speed",
@@ -254,8 +283,9 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     }
     out.push_back(buffer);
   }
-  if (!c.localhost_only) {
-    for (auto& p : out) p.argv.push_back("--all-interfaces");
+  for (auto& p : out) {
+    if (p.name != "cell-sim") p.argv.insert(p.argv.end(), {"--state-dir", c.state_folder().string()});
+    if (!c.localhost_only) p.argv.push_back("--all-interfaces");
   }
   return out;
 }

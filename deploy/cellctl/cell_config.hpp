@@ -54,8 +54,12 @@ struct CellConfig {
   // `bounds: {min: [x, y, z], max: [x, y, z]}`, or the layout's box with a margin.
   Point bounds_min{}, bounds_max{};
   RestartPolicy restart;
+  // `state_dir:` the folder of the cell's database (relative to the file's folder); empty:
+  // $XDG_STATE_HOME (or ~/.local/state)/agile-cell/domain-N.
+  std::filesystem::path state_dir;
 
   std::vector<std::string> resource_ids() const;
+  std::filesystem::path state_folder() const;
 };
 
 // "FILE:LINE: what is wrong".
@@ -69,9 +73,16 @@ CellConfig read_cell_config(const std::filesystem::path& file);
 struct ProcessSpec {
   std::string name;               // resource id, or "cell-sim"
   std::vector<std::string> argv;  // argv[0]: the executable
+  // The others hold state in it (cell-sim's world: their bodies): when it restarts, they do too.
+  bool others_depend = false;
 };
 
 // cell-sim first (the others wait for it), then the station, the robot, the buffers.
 std::vector<ProcessSpec> cell_processes(const CellConfig& cell, const std::filesystem::path& bin_dir);
+
+// The twin of one order on the cell (quiet: whoever started it shows its status).
+std::vector<std::string> twin_argv(const CellConfig& cell, const std::filesystem::path& bin_dir, const std::string& order,
+                                   const std::string& product, const std::string& out, const std::string& sequence,
+                                   const std::string& path, double wait_s = 30);
 
 }  // namespace cellctl

@@ -4,7 +4,7 @@
 
 namespace cellctl {
 
-Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, std::function<void(const std::string&)> log)
+Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log log)
     : policy_(policy), log_(std::move(log)) {
   for (auto& spec : specs) {
     Child child{std::move(spec), nullptr, {}, {}, 0};
@@ -33,13 +33,14 @@ std::string Supervisor::tend() {
       auto backoff = policy_.first_backoff * (1 << std::min<int>(static_cast<int>(c.ends.size()) - 1, 10));
       backoff = std::min(backoff, policy_.max_backoff);
       c.restart_at = now + backoff;
-      log_(c.spec.name + " ended (exit " + std::to_string(code) + "); restarting it in " +
+      log_(c.spec.name, "ended", c.spec.name + " ended (exit " + std::to_string(code) + "); restarting it in " +
            std::to_string(backoff.count()) + " ms");
+      if (c.spec.others_depend) restart_dependents(c);
     } else if (now >= c.restart_at) {
       try {
         c.process = std::make_unique<Process>(c.spec.name, c.spec.argv);
         ++c.restarts;
-        log_(c.spec.name + " restarted (pid " + std::to_string(c.process->pid()) + ", restart " +
+        log_(c.spec.name, "restarted", c.spec.name + " restarted (pid " + std::to_string(c.process->pid()) + ", restart " +
              std::to_string(c.restarts) + ")");
       } catch (const std::exception& e) {
         return c.spec.name + " cannot be started again: " + e.what();
@@ -47,6 +48,23 @@ std::string Supervisor::tend() {
     }
   }
   return "";
+}
+
+// The others' state lived in the process that ended (their bodies in cell-sim's world): they
+// start again after it, and these ends are not theirs to count.
+void Supervisor::restart_dependents(const Child& hub) {
+  std::vector<Process*> running;
+  for (Child& c : children_) {
+    if (&c == &hub || !c.process) continue;
+    running.push_back(c.process.get());
+    c.restart_at = hub.restart_at + std::chrono::milliseconds(100);
+  }
+  log_(hub.spec.name, "restarting all", "the other processes of the cell depend on " + hub.spec.name +
+                                            "; restarting them with it");
+  stop_all(running);
+  for (Child& c : children_) {
+    if (&c != &hub) c.process.reset();
+  }
 }
 
 void Supervisor::stop() {

@@ -18,8 +18,10 @@ namespace cellctl {
 
 class Supervisor {
  public:
+  // What happened to a process ("ended", "restarted"), and the sentence for the operator.
+  using Log = std::function<void(const std::string& process, const std::string& event, const std::string& message)>;
   // Starts every process of the specs, in order.
-  Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, std::function<void(const std::string&)> log);
+  Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log log);
   ~Supervisor();
 
   // Restarts what ended and is due; returns "" while the cell can go on, otherwise why not
@@ -35,8 +37,10 @@ class Supervisor {
     std::chrono::steady_clock::time_point restart_at;
     int restarts = 0;
   };
+  void restart_dependents(const Child& hub);
+
   RestartPolicy policy_;
-  std::function<void(const std::string&)> log_;
+  Log log_;
   std::vector<Child> children_;
 };
 

@@ -35,6 +35,32 @@ std::vector<std::string> Contractor::waiting() const {
   return out;
 }
 
+std::vector<Contractor::Booking> Contractor::bookings() const {
+  std::vector<Booking> out;
+  if (!holder_.order.empty()) out.push_back({holder_.order, holder_.calls, holder_.duration, true});
+  for (const Hold& h : waiting_) out.push_back({h.order, h.calls, h.duration, false});
+  for (const auto& [order, calls] : work_) out.push_back({order, calls, 0, false});
+  return out;
+}
+
+void Contractor::restore(const std::vector<Booking>& bookings) {
+  const double now = now_();
+  for (const Booking& b : bookings) {
+    if (!exclusive_) {
+      work_[b.order].insert(b.calls.begin(), b.calls.end());
+    } else if (b.holds && holder_.order.empty()) {
+      holder_ = {b.order, now + b.duration, b.duration, b.calls};
+    } else {
+      waiting_.push_back({b.order, 0, b.duration, b.calls});
+    }
+  }
+  if (exclusive_ && holder_.order.empty() && !waiting_.empty()) {  // its holder ended meanwhile
+    holder_ = waiting_.front();
+    holder_.until = now + holder_.duration;
+    waiting_.pop_front();
+  }
+}
+
 std::string Contractor::refusal(const std::string& order, const std::string& award) const {
   if (award.empty()) return "the command names no award of " + resource_id_;
   const std::string of_order = " of order " + (order.empty() ? std::string("''") : order);
@@ -100,6 +126,7 @@ void Contractor::award(const Data& d) {
   const double now = now_();
   if (!exclusive_) {
     work_[order].insert(call);
+    persist();  // before the confirmation: what was confirmed survives a restart
     busy_until_ = std::max(now, busy_until_) + duration;
     reply(call, order, true, "", 0);
     return emit("AWARDED", std::move(awarded));
@@ -108,11 +135,13 @@ void Contractor::award(const Data& d) {
     std::set<std::string> calls = holder_.order == order ? holder_.calls : std::set<std::string>{};
     calls.insert(call);
     holder_ = {order, now + duration, duration, std::move(calls)};
+    persist();
     reply(call, order, true, "", 0);
   } else {
     auto it = std::find_if(waiting_.begin(), waiting_.end(), [&](const Hold& h) { return h.order == order; });
     if (it == waiting_.end()) it = waiting_.insert(waiting_.end(), {order, 0, duration, {}});
     it->calls.insert(call);
+    persist();
     reply(call, order, true, "", 1 + (it - waiting_.begin()));
   }
   emit("RESERVED", {{"order_id", holder_.order}});
@@ -125,7 +154,7 @@ void Contractor::end(const std::string& order) {
     it = get<std::string>(it->second, "order_id") == order ? bids_.erase(it) : std::next(it);
   }
   if (!exclusive_) {
-    work_.erase(order);
+    if (work_.erase(order) > 0) persist();
     return;
   }
   const auto it = std::find_if(waiting_.begin(), waiting_.end(), [&](const Hold& h) { return h.order == order; });
@@ -141,6 +170,7 @@ void Contractor::end(const std::string& order) {
   } else {
     return;
   }
+  persist();
   emit("RESERVED", {{"order_id", holder_.order}});
 }
 

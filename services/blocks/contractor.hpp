@@ -49,6 +49,21 @@ class Contractor : public BasicBlock {
 
   const std::string& reserved_by() const { return holder_.order; }
   std::vector<std::string> waiting() const;
+  // What the resource has taken on: the order that holds it and those waiting, in turn
+  // (exclusive), or the orders whose work it took (shared), with the awards of each. A
+  // process that follows one that ended takes them up again (restore), so that a station
+  // restarted with a half-built product on its table is still its order's.
+  struct Booking {
+    std::string order;
+    std::set<std::string> calls;
+    double duration = 0;
+    bool holds = false;  // exclusive: the holder
+  };
+  std::vector<Booking> bookings() const;
+  void restore(const std::vector<Booking>& bookings);
+  // Called with the bookings each time they change (an award taken, an order ended).
+  void persist_with(std::function<void(const std::vector<Booking>&)> persist) { persist_ = std::move(persist); }
+
   // Authorization of a command: "" when `award` is a call this resource confirmed for
   // `order` and the order holds the resource now (exclusive) or has work taken on by it
   // (shared); otherwise why not ("arm-1 is reserved by ok1").
@@ -77,6 +92,10 @@ class Contractor : public BasicBlock {
   std::map<std::string, Data> bids_;           // call id -> the call offered for, with the bid's duration
   std::map<std::string, std::set<std::string>> work_;  // shared: order -> awards taken on
   double busy_until_ = 0;                      // shared: the end of the work taken on
+  std::function<void(const std::vector<Booking>&)> persist_;
+  void persist() const {
+    if (persist_) persist_(bookings());
+  }
 };
 
 }  // namespace fb

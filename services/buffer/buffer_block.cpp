@@ -1,5 +1,7 @@
 #include "services/buffer/buffer_block.hpp"
 
+#include "services/state/cell_store.hpp"
+
 namespace fb {
 
 BufferBlock::BufferBlock(std::string name, std::string resource_id, std::map<std::string, int> stock)
@@ -19,6 +21,11 @@ BufferBlock::BufferBlock(std::string name, std::string resource_id, std::map<std
     if (kept == 0 && free(type) == 0) {
       return emit("FAIL", {{"reason", "buffer " + this->resource_id() + " has no " + type +
                                            (order.empty() ? "" : " free for order " + order)}});
+    }
+    // The durable stock first: a part counted out in memory only would come back with a restart.
+    if (store()) {
+      store()->give(this->resource_id(), type, order, get_or<std::string>(d, "part", ""),
+                    get_or<std::string>(d, "destination", ""));
     }
     if (kept > 0) --kept;
     --stock_[type];
@@ -45,6 +52,12 @@ void BufferBlock::check(const Data& command, SampleCheck& c) const {
   if (get<std::string>(command, "operation") == "give" && get_or<std::string>(command, "part", "").empty()) {
     c.text("part_type", true);
   }
+}
+
+std::string BufferBlock::recover() {
+  const std::map<std::string, int> before = stock_;
+  stock_ = store()->open_buffer(resource_id(), stock_);
+  return stock_ == before ? "" : "stock as stored, not as the deployment file gives it";
 }
 
 void BufferBlock::order_ended(const std::string& order) { kept_.erase(order); }

@@ -5,7 +5,10 @@
 // the free stock when the order ends.
 //
 //   AWARDED (order_id, part_type, count): keep that many for the order
-//   START (order_id, part_type)  ->  DONE, CAPABILITY (the stock changed)  or  FAIL (reason)
+//   START (order_id, part_type, part, destination: who takes it)  ->  DONE, CAPABILITY (the
+//         stock changed)  or  FAIL (reason)
+// With the cell's durable state, the stock is the stored one, and a part given is recorded
+// as in transit with whoever took it, in the same transaction that counts it out.
 
 #include <map>
 #include <string>
@@ -24,6 +27,7 @@ class BufferBlock : public DeviceBlock {
 
  private:
   void order_ended(const std::string& order) override;
+  std::string recover() override;
   void check(const Data& command, SampleCheck& check) const override;
 
   std::map<std::string, int> stock_;

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   app.add_option("--stock", stock, "TYPE=COUNT, repeatable");
   app.add_option("--position", config.node.position, "Where it stands: x y z, m");
   app.add_option("--lease", config.node.liveliness_lease_s, "Liveliness lease of the capability, s");
+  dds::add_state_option(app, config.node.state_dir);
   try {
     app.parse(argc, argv);
     dds::apply_interfaces(config.dds, all_interfaces);

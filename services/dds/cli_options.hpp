@@ -22,6 +22,11 @@ inline void add_bounds_option(CLI::App& app, std::vector<double>& values) {
       ->expected(6);
 }
 
+// --state-dir DIR: the folder of the cell's durable state (docs/durable-state.md).
+inline void add_state_option(CLI::App& app, std::string& state_dir) {
+  app.add_option("--state-dir", state_dir, "Folder of the cell's database (default: state kept in memory only)");
+}
+
 inline fb::CellBounds apply_bounds(const std::vector<double>& values) {
   fb::CellBounds b;
   if (values.size() != 6) return b;

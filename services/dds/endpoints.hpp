@@ -2,6 +2,7 @@
 // Typed DDS writers and readers on a participant, with the QoS of their topic kind.
 // T is a fastddsgen type, PubSubType its generated TypeSupport class.
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -75,11 +76,25 @@ class Writer : private fdds::DataWriterListener {
     return matched_changed_.wait_for(lock, timeout, [&] { return matched_ >= readers; });
   }
 
+  // Waits until some reader has matched and no match came or went for `quiet` (discovery of
+  // the participants already there is done), at most `timeout`; the readers matched.
+  int wait_for_settled_readers(std::chrono::milliseconds quiet, std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (std::chrono::steady_clock::now() < deadline) {
+      const auto settled_at = std::min(matched_at_ + quiet, deadline);
+      if (matched_ > 0 && std::chrono::steady_clock::now() >= matched_at_ + quiet) break;
+      matched_changed_.wait_until(lock, matched_ > 0 ? settled_at : deadline);
+    }
+    return matched_;
+  }
+
  private:
   void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closed_) return;
     matched_ = status.current_count;
+    matched_at_ = std::chrono::steady_clock::now();
     matched_changed_.notify_all();  // under the lock: the destructor cannot take the condition away meanwhile
   }
 
@@ -89,6 +104,7 @@ class Writer : private fdds::DataWriterListener {
   std::mutex mutex_;
   std::condition_variable matched_changed_;
   int matched_ = 0;
+  std::chrono::steady_clock::time_point matched_at_ = std::chrono::steady_clock::now();
   bool closed_ = false;
 };
 

@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   app.add_option("--home", config.position, "Where it waits: x y z, m");
   app.add_option("--speed", config.speed, "m/s")->check(CLI::PositiveNumber);
   app.add_option("--lease", config.liveliness_lease_s, "Liveliness lease of the capability, s");
+  dds::add_state_option(app, config.state_dir);
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(dds, all_interfaces);
   std::signal(SIGINT, stop);

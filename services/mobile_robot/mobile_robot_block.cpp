@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "services/state/cell_store.hpp"
+
 namespace fb {
 
 MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers home, double speed)
@@ -72,6 +74,7 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
                   {"operation", std::string("give")},
                   {"part", fetch_.at("part")},
                   {"part_type", fetch_.at("part_type")},
+                  {"destination", resource_id()},  // who takes the part: the buffer's record says so
                   {"sim_time", get<double>(reply, "end_time")}});
   }, arrived);
   transition("TO_SOURCE", "SIM_REPLY", "READY", fail, answered);
@@ -81,9 +84,26 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   transition("WAIT_GIVE", "GIVE_EVENT", "READY", [this](const Data& d) {
     emit("FAIL", {{"reason", get<std::string>(d, "reason")}, {"distance", distance_}, {"duration", moving_}});
   }, [give_answer](const Data& d) { return give_answer("aborted")(d) || give_answer("rejected")(d); });
-  transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, account](const Data& reply) { emit("DONE", account(reply)); },
-             arrived);
-  transition("TO_DESTINATION", "SIM_REPLY", "READY", fail, answered);
+  transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, account](const Data& reply) {
+    if (store()) {
+      store()->deliver(get_or<std::string>(fetch_, "order_id", ""), get<std::string>(fetch_, "part"),
+                       get<std::string>(fetch_, "destination"));
+    }
+    emit("DONE", account(reply));
+  }, arrived);
+  // A delivery that failed on the way: the part goes back to its buffer.
+  transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, fail](const Data& reply) {
+    if (store()) store()->return_carried(resource_id());
+    fail(reply);
+  }, answered);
+}
+
+std::string MobileRobotBlock::recover() {
+  std::string out;
+  for (const auto& p : store()->return_carried(resource_id())) {
+    out += (out.empty() ? "" : ", ") + p.part + " (" + p.part_type + ") back to " + p.buffer;
+  }
+  return out.empty() ? "" : "the part it carried went back: " + out;
 }
 
 void MobileRobotBlock::check(const Data& command, SampleCheck& c) const {

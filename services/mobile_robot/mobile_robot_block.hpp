@@ -29,6 +29,7 @@ class MobileRobotBlock : public DeviceBlock {
 
  private:
   void check(const Data& command, SampleCheck& check) const override;
+  std::string recover() override;
   void drive_to(const std::string& place, const std::vector<std::string>& carried);
   std::string body() const { return resource_id() + "/base"; }
 

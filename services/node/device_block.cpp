@@ -88,4 +88,9 @@ void DeviceBlock::receive(const Event& event) {
   BasicBlock::receive(event);
 }
 
+std::string DeviceBlock::keep_state_in(state::CellStore& store) {
+  store_ = &store;
+  return recover();
+}
+
 }  // namespace fb

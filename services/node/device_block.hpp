@@ -33,6 +33,10 @@
 #include "services/blocks/sample_checks.hpp"
 #include "services/runtime/basic_block.hpp"
 
+namespace state {
+class CellStore;
+}
+
 namespace fb {
 
 class DeviceBlock : public BasicBlock {
@@ -56,7 +60,14 @@ class DeviceBlock : public BasicBlock {
 
   void receive(const Event& event) override;
 
+  // The cell's durable state (docs/durable-state.md), where the process keeps one; the
+  // device takes back what a process before it left there (a buffer its stock), and says
+  // in a sentence what it did with what it held when that process ended ("" for nothing).
+  std::string keep_state_in(state::CellStore& store);
+
  protected:
+  state::CellStore* store() const { return store_; }
+  virtual std::string recover() { return ""; }
   // An order ended (done, failed, its twin gone): a device frees what it kept for it.
   virtual void order_ended(const std::string& /*order*/) {}
   // Adds a device's own checks of a command to the common ones.
@@ -72,6 +83,7 @@ class DeviceBlock : public BasicBlock {
   std::set<std::string> ended_orders_;
   CellBounds bounds_;
   Authorize authorize_;
+  state::CellStore* store_ = nullptr;
   std::size_t refused_ = 0;
   std::string last_refusal_;
 

@@ -12,6 +12,7 @@
 #include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
 #include "services/node/sim_requests.hpp"
+#include "services/state/cell_store.hpp"
 #include "simulationPubSubTypes.h"
 
 namespace services {
@@ -72,6 +73,8 @@ struct ResourceNode::Impl {
   fb::DeviceBlock& device;
   fb::Contractor* contractor = nullptr;
   std::function<void(cell::Capability&)> describe;
+  std::unique_ptr<state::CellStore> store;
+  std::string recovered;  // what the device did with what its predecessor process held
   dds::SimClock clock;
   std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
   // Answers to commands the resource's queue had no room for, written on the listener thread.
@@ -133,6 +136,56 @@ struct ResourceNode::Impl {
     capabilities->write(c);
   }
 
+  // Takes up what the process before it had taken on, but for orders that ended meanwhile;
+  // from now on every change is stored before it is confirmed.
+  void keep_bookings() {
+    std::set<std::string> ended;
+    for (const auto& o : store->orders()) {
+      if (o.ended()) ended.insert(o.order);
+    }
+    std::vector<fb::Contractor::Booking> restored;
+    std::string orders;
+    for (const auto& b : store->bookings(config.id)) {
+      if (ended.count(b.order)) continue;
+      restored.push_back({b.order, std::set<std::string>(b.calls.begin(), b.calls.end()), b.duration, b.holds});
+      orders += (orders.empty() ? "" : ", ") + b.order + (b.holds ? " (holds it)" : "");
+    }
+    contractor->restore(restored);
+    if (!orders.empty()) store->journal(config.id, "bookings restored", "", orders);
+    const auto save = [this](const std::vector<fb::Contractor::Booking>& bookings) {
+      std::vector<state::BookingRecord> records;
+      for (const auto& b : bookings) records.push_back({b.order, {b.calls.begin(), b.calls.end()}, b.duration, b.holds});
+      store->set_bookings(config.id, records);
+    };
+    save(contractor->bookings());
+    contractor->persist_with(save);
+  }
+
+  // The commands the process before this one had taken on when it ended: ABORTED, with why.
+  void answer_interrupted() {
+    const auto interrupted = store->take_interrupted(config.id);
+    if (interrupted.empty()) return;
+    // An event nobody hears is lost: the readers already there (the commanders' among them)
+    // are given time to match.
+    overflow_answers->wait_for_settled_readers(std::chrono::milliseconds(500), std::chrono::seconds(3));
+    for (const auto& c : interrupted) {
+      const bool concerned = !c.part.empty() && recovered.find(c.part) != std::string::npos;
+      const std::string reason = config.id + " restarted: its process ended with this command under way or queued" +
+                                 (concerned ? "; " + recovered : "");
+      store->journal(config.id, "aborted", c.order, c.command_id + ": " + reason);
+      cell::CommandEvent e;
+      e.command_id(c.command_id);
+      e.resource_id(config.id);
+      e.order_id(c.order);
+      e.operation(c.operation);
+      e.part(c.part);
+      e.state(cell::ABORTED);
+      e.reason(reason.substr(0, cell::Text::max_size - 1));
+      e.sim_time(clock.now());
+      overflow_answers->write(e);
+    }
+  }
+
   cell::CommandEvent event_of(cell::CommandState state, const fb::Data& d) {
     const std::string& id = fb::get<std::string>(d, "command_id");
     const fb::Data& known = device.command(id);
@@ -151,6 +204,13 @@ struct ResourceNode::Impl {
     clock.observe(fb::get_or<double>(command, "sim_time", 0));
     if (const auto t = d.find("sim_time"); t != d.end()) clock.observe(std::get<double>(t->second));
     e.sim_time(d.count("sim_time") ? fb::get<double>(d, "sim_time") : clock.now());
+    if (store && !known.empty()) {
+      if (state == cell::ACCEPTED) {
+        store->command_taken({config.id, id, e.order_id().to_string(), e.operation().to_string(), e.part().to_string()});
+      } else if (is_final(state)) {
+        store->command_ended(config.id, id);
+      }
+    }
     if (is_final(state) && !known.empty()) {
       fb::Data last = d;
       last["state"] = std::string(dds::state_name(state));
@@ -177,6 +237,11 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     : impl_(std::make_unique<Impl>(resource, participant, std::move(config), device)) {
   Impl& n = *impl_;
   n.describe = std::move(describe);
+  if (!n.config.state_dir.empty()) {
+    n.store = std::make_unique<state::CellStore>(n.config.state_dir);
+    n.recovered = device.keep_state_in(*n.store);
+    if (!n.recovered.empty()) n.store->journal(n.config.id, "recovered", "", n.recovered);
+  }
   dds::QosSettings qos;
   qos.liveliness_lease_s = n.config.liveliness_lease_s;
   n.capabilities = std::make_unique<dds::Writer<cell::Capability, cell::CapabilityPubSubType>>(
@@ -240,6 +305,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   // The contract net.
   n.contractor = &resource.add(std::make_unique<fb::Contractor>("contractor", n.config.id, n.config.offers, n.config.exclusive,
                                                                 std::move(estimate), [&n] { return n.clock.now(); }));
+  if (n.store) n.keep_bookings();
   n.subscribe<cell::CallForProposals, cell::CallForProposalsPubSubType>(
       "calls", "cell/negotiation/calls", TopicKind::events, [](const cell::CallForProposals& c) { return dds::to_data(c); });
   n.subscribe<cell::Award, cell::AwardPubSubType>("awards", "cell/negotiation/awards", TopicKind::events,
@@ -309,6 +375,7 @@ void ResourceNode::start(std::chrono::milliseconds wait_for_sim, const std::atom
   }
   publish_capability();
   for (auto& start : n.starters) start();
+  if (n.store) n.answer_interrupted();
   if (!n.sim_requests) return;
   // And its replies must reach this process: DDS matches each pair of endpoints on its own,
   // and a device whose first reply was lost (its spawn) never became ready. Pinged until it

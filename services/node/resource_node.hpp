@@ -13,6 +13,11 @@
 //   device.SIM --> cell/sim/requests;  cell/sim/replies --> device.SIM_REPLY
 //   device.CAPABILITY --> cell/capabilities (e.g. a buffer's stock changed)
 //
+// With a state folder, the node keeps in the cell's database the command under way and the
+// order that holds the resource. A process that follows one that ended answers the command
+// its predecessor left ABORTED, with the reason and what became of a part it held; the hold
+// is gone with the process that had it (the journal says whose it was).
+//
 // A device block is any DeviceBlock; the node adds no product knowledge.
 
 #include <array>
@@ -47,6 +52,8 @@ struct NodeConfig {
   double liveliness_lease_s = 5.0;
   fb::CellBounds bounds;     // commands' positions must lie inside
   fb::CommandLifecycle::WhenBusy when_busy = fb::CommandLifecycle::WhenBusy::reject;
+  // The cell's durable state (services/state): "" keeps everything in memory alone.
+  std::string state_dir;
 };
 
 class ResourceNode {

@@ -1,5 +1,7 @@
 #include "services/station/arm_block.hpp"
 
+#include "services/state/cell_store.hpp"
+
 namespace fb {
 
 ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
@@ -34,6 +36,7 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
     }, op(motion));
   }
   transition("READY", "START", "READY", [this](const Data&) {
+    if (store() && !held_.empty()) store()->release(held_order_, held_);
     held_.clear();
     emit("DONE");
   }, op("release"));
@@ -99,6 +102,18 @@ void ArmBlock::grip(const Data& d) {
   request(sim_.spawn(carriage(), carriage_body.pose, carriage_body.half_extents, false));
   has_gripper_ = true;
   held_ = get<std::string>(d, "part");
+  held_order_ = get_or<std::string>(d, "order_id", "");
+  // In the gripper from the moment the grip begins: a part half gripped when the arm's
+  // process ends is one for inspection.
+  if (store() && !held_.empty()) store()->grip(held_order_, held_, resource_id());
+}
+
+std::string ArmBlock::recover() {
+  std::string out;
+  for (const auto& p : store()->hold_for_inspection(resource_id())) {
+    out += (out.empty() ? "" : ", ") + p.part + " (" + p.part_type + ", order " + p.order + ")";
+  }
+  return out.empty() ? "" : "held for inspection: " + out + " (it was in the gripper)";
 }
 
 }  // namespace fb

@@ -30,6 +30,7 @@ class ArmBlock : public DeviceBlock {
   const std::string& held() const { return held_; }
 
  private:
+  std::string recover() override;
   void check(const Data& command, SampleCheck& check) const override;
   void grip(const Data& command);
   std::string pad() const { return resource_id() + "/pad"; }
@@ -38,7 +39,7 @@ class ArmBlock : public DeviceBlock {
 
   ArmSettings settings_;
   SimRequests sim_;
-  std::string held_;
+  std::string held_, held_order_;
   bool has_gripper_ = false;
   int awaited_ = 0;  // replies still to come for the current command
   std::string error_;

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   app.add_option("--arm-speed", arm_settings.speed, "m/s")->check(CLI::PositiveNumber);
   app.add_option("--arm-angular-speed", arm_settings.angular_speed, "rad/s")->check(CLI::PositiveNumber);
   app.add_option("--lease", station.liveliness_lease_s, "Liveliness lease of the capabilities, s");
+  dds::add_state_option(app, station.state_dir);
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(dds, all_interfaces);
   arm.position = station.position;
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
   arm.speed = arm_settings.speed;
   arm.angular_speed = arm_settings.angular_speed;
   arm.liveliness_lease_s = station.liveliness_lease_s;
+  arm.state_dir = station.state_dir;
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   services::stop_with_parent();

@@ -228,7 +228,8 @@ TEST_CASE("cell up: a bad order fails alone, the cell stays idle and usable, dow
   test::clean_stale_dds_segments();
   const fs::path dir = scratch("bad-order");
   const std::string domain = "188";
-  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "50"}, (dir / "up.log").string());
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
+                        (dir / "up.log").string());
 
   const int bad = cellctl({"submit", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "--domain", domain,
                            "--order", "bad", "--out", (dir / "bad").string()},
@@ -281,7 +282,8 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
                              (dir / "early").string(), "--wait", "60"},
                             (dir / "early.log").string());
     std::this_thread::sleep_for(1s);
-    test::ChildProcess up({CELLCTL_EXE, "up", "--domain", "190", "--real-time-factor", "50"}, (dir / "up.log").string());
+    test::ChildProcess up({CELLCTL_EXE, "up", "--domain", "190", "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
+                          (dir / "up.log").string());
     const int code = twin.wait_for_exit(90s);
     INFO(read_text(dir / "early.log") << read_text(dir / "up.log"));
     CHECK(code == 0);
@@ -324,7 +326,8 @@ TEST_CASE("a twin that dies mid-order: its reservations lapse, its parts leave c
   const fs::path dir = scratch("twin-dies");
   const std::string domain = "192";
   const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
-  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "20"}, (dir / "up.log").string());
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "20", "--state-dir", (dir / "state").string()},
+                        (dir / "up.log").string());
   test::ChildProcess twin({TWIN_EXE, "--domain", domain, "--order", "doomed", "--product", product, "--out",
                            (dir / "doomed").string(), "--lease", "0.5"},
                           (dir / "doomed.log").string());

@@ -65,7 +65,8 @@ class HostileCell {
  public:
   HostileCell(int domain, const std::string& name)
       : domain_(std::to_string(domain)), dir_(test::scratch(name)),
-        up_({CELLCTL_EXE, "up", "--domain", domain_, "--real-time-factor", "20"}, (dir_ / "up.log").string()),
+        up_({CELLCTL_EXE, "up", "--domain", domain_, "--real-time-factor", "20", "--state-dir", (dir_ / "state").string()},
+            (dir_ / "up.log").string()),
         intruder_(dds::make_participant("intruder", {domain, true})) {
     events_ = std::make_unique<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>>(
         intruder_, "cell/command_events", dds::TopicKind::events, [this](const cell::CommandEvent& e) {

@@ -31,7 +31,8 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nrestart: {limit: 2, window: 60}\n";
   const std::string domain = "220";
   const fs::path log = dir / "up.log";
-  test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain}, log.string());
+  test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain, "--state-dir", (dir / "state").string()},
+                        log.string());
   REQUIRE(appears(log, "cell up on domain"));
 
   // buffer-2 (the Lego bricks) dies hard: it is back, and a Lego order is assembled.
@@ -68,7 +69,7 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
   const fs::path dir = test::scratch("up-killed");
   const std::string domain = "221";
   const fs::path log = dir / "up.log";
-  auto up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain},
+  auto up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain, "--state-dir", (dir / "state").string()},
                                                  log.string());
   REQUIRE(appears(log, "cell up on domain"));
   CHECK(test::cellctl({"up", "--domain", domain}, dir / "second.log", 30s) == 1);
@@ -93,7 +94,7 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
 
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 1);
   CHECK(test::read_text(dir / "down.log").find("its cellctl up was killed") != std::string::npos);
-  up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain},
+  up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain, "--state-dir", (dir / "state").string()},
                                             (dir / "again.log").string());
   REQUIRE(appears(dir / "again.log", "cell up on domain"));
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down2.log", 30s) == 0);

@@ -225,3 +225,41 @@ TEST_CASE("contract net: calls and bids that are not numbers are refused with a 
   REQUIRE(names<fb::Negotiator>(award) == Names{"AWARD"});
   CHECK(fb::get<std::string>(award[0].data, "resource_id") == "station-2");
 }
+
+TEST_CASE("contractor: what it took on is stored before it is confirmed, and a successor takes it up", "[fb][negotiation]") {
+  now = 100;
+  std::vector<fb::Contractor::Booking> stored;
+  std::size_t stores = 0;
+  fb::BlockTestFixture<fb::Contractor> f("contractor", "station-1", std::set<std::string>{"host"}, true, holds(),
+                                         [] { return now; });
+  f.block().persist_with([&](const std::vector<fb::Contractor::Booking>& b) {
+    stored = b;
+    ++stores;
+  });
+  f.send("CFP", cfp("o1", "host", 30));
+  f.send("AWARD", award("o1", "host"));
+  f.send("CFP", cfp("o2", "host", 20));
+  f.send("AWARD", award("o2", "host"));
+  CHECK(stores == 2);
+  REQUIRE(stored.size() == 2);
+  CHECK(stored[0].order == "o1");
+  CHECK(stored[0].holds);
+  CHECK(stored[1].order == "o2");
+  CHECK(stored[1].calls == std::set<std::string>{"o2/host"});
+
+  // The process ends; the next one restores: o1 still holds it, o2 still waits.
+  fb::BlockTestFixture<fb::Contractor> next("contractor", "station-1", std::set<std::string>{"host"}, true, holds(),
+                                            [] { return now; });
+  next.block().restore(stored);
+  CHECK(next.block().reserved_by() == "o1");
+  CHECK(next.block().waiting() == Names{"o2"});
+  CHECK(next.block().refusal("o1", "o1/host").empty());
+  CHECK(next.block().refusal("o2", "o2/host") == "station-1 is reserved by o1");
+
+  // A holder that ended meanwhile was left out: the first waiting order holds it.
+  fb::BlockTestFixture<fb::Contractor> after("contractor", "station-1", std::set<std::string>{"host"}, true, holds(),
+                                             [] { return now; });
+  after.block().restore({stored[1]});
+  CHECK(after.block().reserved_by() == "o2");
+  CHECK(after.block().waiting().empty());
+}

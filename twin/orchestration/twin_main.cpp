@@ -30,6 +30,7 @@
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/plan_json.hpp"
 #include "services/node/run.hpp"
+#include "services/state/cell_store.hpp"
 
 namespace {
 
@@ -50,7 +51,7 @@ cell::OrderState order_state(const std::string& s) {
 
 struct Options {
   dds::ParticipantSettings dds;
-  std::string order, product, out = ".", sequence = "search", path = "linear";
+  std::string order, product, out = ".", sequence = "search", path = "linear", state_dir;
   double wait_s = 30, lease_s = 5;
   bool verbose = false;
   bool quiet = false;
@@ -66,6 +67,7 @@ class TwinProcess {
         participant_, "cell/orders/status", TopicKind::state, qos);
     result_ = std::make_unique<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>>(
         participant_, "cell/orders/result", TopicKind::state, qos);
+    if (!o.state_dir.empty()) store_ = std::make_unique<state::CellStore>(o.state_dir);
   }
 
   void status(const std::string& state, const std::string& message, double progress) {
@@ -76,6 +78,15 @@ class TwinProcess {
     s.progress(progress);
     s.sim_time(clock_.now());
     status_->write(s);
+    if (store_ && state != stored_state_) {
+      // The product is done: its parts on the station are counted as assembled from now on.
+      if (state == "DONE") store_->assemble(options_.order);
+      // A twin told to stop (the cell goes down) leaves its order to be taken up again.
+      const std::string stored = state == "FAILED" && !running ? "INTERRUPTED" : state;
+      store_->set_order(options_.order, stored, state == "FAILED" ? message : "");
+      store_->journal("twin-" + options_.order, stored, options_.order, message);
+      stored_state_ = state;
+    }
     if (!options_.quiet) std::cout << "[" << options_.order << "] " << state << ": " << message << std::endl;
   }
 
@@ -92,6 +103,15 @@ class TwinProcess {
   // Plans, then orchestrates; returns the exit code.
   int run() {
     status("SUBMITTED", options_.product, 0);
+    if (store_) {
+      // A twin before this one ended with parts handed out for the order: they stand where the
+      // store says, and this version does not take physical assembly up from the middle.
+      if (const auto parts = store_->parts(options_.order); !parts.empty()) {
+        return end_with(1, "its twin ended during physical assembly with " + std::to_string(parts.size()) +
+                               " parts handed out (`cellctl status` says where they are); clear the station, "
+                               "then submit the order again under a new id");
+      }
+    }
     sim::MeshCache meshes;
     std::optional<twin::LoadedProduct> loaded;
     try {
@@ -119,6 +139,7 @@ class TwinProcess {
   // `reported`: the orchestrator has published FAILED already.
   int end_with(int code, const std::string& error, const std::string& plan_file = "", bool reported = false) {
     if (!reported) status("FAILED", error, 0);
+    if (store_ && running) store_->set_order(options_.order, "FAILED", error, code);
     result(false, plan_file, "", error);
     std::cerr << "error: order " << options_.order << ": " << error << '\n';
     linger();
@@ -262,6 +283,7 @@ class TwinProcess {
     twin::write_gltf_animation(product, validated, animation);
     if (!orchestrator.error().empty()) return end_with(1, orchestrator.error(), plan_file.string(), true);
     result(true, plan_file.string(), animation.string(), "");
+    if (store_) store_->set_order(options_.order, "DONE", "", 0);
     linger();
     return 0;
   }
@@ -272,6 +294,8 @@ class TwinProcess {
   std::unique_ptr<dds::Writer<cell::OrderStatus, cell::OrderStatusPubSubType>> status_;
   std::unique_ptr<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>> result_;
   std::vector<std::function<void()>> starters_;
+  std::unique_ptr<state::CellStore> store_;  // the cell's durable state, if it keeps one
+  std::string stored_state_;
 };
 
 }  // namespace
@@ -288,6 +312,7 @@ int main(int argc, char** argv) {
   app.add_option("--path", o.path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);
   app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
+  dds::add_state_option(app, o.state_dir);
   app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
   app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
   CLI11_PARSE(app, argc, argv);

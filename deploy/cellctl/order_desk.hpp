@@ -1,0 +1,42 @@
+#pragma once
+// The cell's order desk, run by `cellctl up`: orders are rows of the cell's database
+// (`cellctl submit` writes one), and the desk keeps a twin running for every order that has
+// not ended. A twin that dies before its order ended is started again after a second, and
+// the new twin takes the order up from the database (services/state); after `max_attempts`
+// twins the order fails with the reason. A twin the desk stops (the cell goes down) records
+// its order INTERRUPTED, and the next `cellctl up` on the same state takes it up again.
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/processes.hpp"
+#include "services/state/cell_store.hpp"
+
+namespace cellctl {
+
+class OrderDesk {
+ public:
+  OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
+            int max_attempts = 3);
+  ~OrderDesk();
+
+  // Starts twins for the orders that have none, notes the twins that ended. Call often.
+  void tend();
+  // Stops every twin (each records its order INTERRUPTED); tend() starts them again.
+  void interrupt_all();
+  std::size_t running() const { return twins_.size(); }
+
+ private:
+  const CellConfig& cell_;
+  state::CellStore& store_;
+  std::function<void(const std::string&)> log_;
+  int max_attempts_;
+  std::map<std::string, std::unique_ptr<Process>> twins_;                   // order -> its twin
+  std::map<std::string, std::chrono::steady_clock::time_point> not_before_;  // order -> next start
+};
+
+}  // namespace cellctl

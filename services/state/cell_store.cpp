@@ -1,0 +1,433 @@
+#include "services/state/cell_store.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace state {
+namespace {
+
+constexpr const char* kSchema = R"sql(
+CREATE TABLE IF NOT EXISTS stock(
+  buffer TEXT NOT NULL, part_type TEXT NOT NULL,
+  initial INTEGER NOT NULL, count INTEGER NOT NULL CHECK(count >= 0),
+  PRIMARY KEY(buffer, part_type));
+CREATE TABLE IF NOT EXISTS parts(
+  order_id TEXT NOT NULL, part TEXT NOT NULL, part_type TEXT NOT NULL, buffer TEXT NOT NULL,
+  place TEXT NOT NULL CHECK(place IN ('in_transit','on_station','in_gripper','assembled','inspection','returned')),
+  holder TEXT NOT NULL DEFAULT '', station TEXT NOT NULL DEFAULT '',
+  PRIMARY KEY(order_id, part));
+CREATE TABLE IF NOT EXISTS commands(
+  resource TEXT NOT NULL, command_id TEXT NOT NULL, order_id TEXT NOT NULL, operation TEXT NOT NULL,
+  part TEXT NOT NULL, PRIMARY KEY(resource, command_id));
+CREATE TABLE IF NOT EXISTS bookings(
+  resource TEXT NOT NULL, position INTEGER NOT NULL, order_id TEXT NOT NULL, holds INTEGER NOT NULL,
+  duration REAL NOT NULL, call_id TEXT NOT NULL);
+CREATE INDEX IF NOT EXISTS bookings_of ON bookings(resource);
+CREATE TABLE IF NOT EXISTS orders(
+  order_id TEXT PRIMARY KEY, state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '', updated REAL,
+  product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', sequence TEXT NOT NULL DEFAULT '',
+  path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0);
+CREATE TABLE IF NOT EXISTS journal(
+  seq INTEGER PRIMARY KEY AUTOINCREMENT, time REAL NOT NULL, source TEXT NOT NULL, event TEXT NOT NULL,
+  order_id TEXT NOT NULL, detail TEXT NOT NULL);
+)sql";
+
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+Place place_of(const std::string& name) {
+  for (Place p : {Place::in_transit, Place::on_station, Place::in_gripper, Place::assembled, Place::inspection,
+                  Place::returned}) {
+    if (name == place_name(p)) return p;
+  }
+  throw StoreError("unknown place '" + name + "' in the parts table");
+}
+
+}  // namespace
+
+const char* place_name(Place p) {
+  switch (p) {
+    case Place::in_transit: return "in_transit";
+    case Place::on_station: return "on_station";
+    case Place::in_gripper: return "in_gripper";
+    case Place::assembled: return "assembled";
+    case Place::inspection: return "inspection";
+    case Place::returned: return "returned";
+  }
+  return "?";
+}
+
+// A prepared statement, its parameters bound in order.
+class CellStore::Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK) fail("prepare");
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  template <class... Args>
+  Statement& bind(const Args&... args) {
+    int i = 0;
+    (bind_one(++i, args), ...);
+    return *this;
+  }
+  // True while there is a row.
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc != SQLITE_DONE) fail("step");
+    return false;
+  }
+  std::string text(int column) const {
+    const auto* t = sqlite3_column_text(stmt_, column);
+    return t ? reinterpret_cast<const char*>(t) : "";
+  }
+  long integer(int column) const { return static_cast<long>(sqlite3_column_int64(stmt_, column)); }
+  double real(int column) const { return sqlite3_column_double(stmt_, column); }
+
+ private:
+  void bind_one(int i, const std::string& s) { sqlite3_bind_text(stmt_, i, s.data(), static_cast<int>(s.size()), SQLITE_TRANSIENT); }
+  void bind_one(int i, const char* s) { sqlite3_bind_text(stmt_, i, s, -1, SQLITE_TRANSIENT); }
+  void bind_one(int i, long v) { sqlite3_bind_int64(stmt_, i, v); }
+  void bind_one(int i, int v) { sqlite3_bind_int64(stmt_, i, v); }
+  void bind_one(int i, double v) { sqlite3_bind_double(stmt_, i, v); }
+  [[noreturn]] void fail(const char* what) const {
+    throw StoreError(std::string("cell state: ") + what + ": " + sqlite3_errmsg(db_));
+  }
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+// BEGIN IMMEDIATE (the write lock at once, so that two writers never deadlock upgrading a
+// read lock) ... COMMIT; rolled back when left by an exception.
+class CellStore::Transaction {
+ public:
+  explicit Transaction(const CellStore& store, const char* begin = "BEGIN IMMEDIATE") : store_(store) {
+    store_.exec(begin);
+  }
+  ~Transaction() {
+    if (!done_) sqlite3_exec(store_.db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+  void commit() {
+    store_.exec("COMMIT");
+    done_ = true;
+  }
+
+ private:
+  const CellStore& store_;
+  bool done_ = false;
+};
+
+CellStore::CellStore(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw StoreError("cell state: cannot create " + dir.string() + ": " + ec.message());
+  const std::string file = file_in(dir).string();
+  if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK) {
+    const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    throw StoreError("cell state: cannot open " + file + ": " + why);
+  }
+  // Several processes write: a writer waits for another's short transaction rather than fail.
+  sqlite3_busy_timeout(db_, 10000);
+  try {
+    exec("PRAGMA journal_mode=WAL");
+    exec("PRAGMA synchronous=FULL");
+    exec("PRAGMA foreign_keys=ON");
+    Transaction t(*this);
+    exec(kSchema);
+    t.commit();
+  } catch (...) {
+    sqlite3_close(db_);
+    throw;
+  }
+}
+
+CellStore::~CellStore() { sqlite3_close(db_); }
+
+void CellStore::exec(const char* sql) const {
+  char* error = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &error) != SQLITE_OK) {
+    const std::string why = error ? error : sqlite3_errmsg(db_);
+    sqlite3_free(error);
+    throw StoreError(std::string("cell state: ") + why);
+  }
+}
+
+std::map<std::string, int> CellStore::open_buffer(const std::string& buffer, const std::map<std::string, int>& seed) {
+  Transaction t(*this);
+  Statement known(db_, "SELECT COUNT(*) FROM stock WHERE buffer = ?");
+  known.bind(buffer).step();
+  if (known.integer(0) == 0) {
+    for (const auto& [type, count] : seed) {
+      Statement(db_, "INSERT INTO stock(buffer, part_type, initial, count) VALUES(?, ?, ?, ?)")
+          .bind(buffer, type, count, count)
+          .step();
+    }
+  }
+  std::map<std::string, int> counts;
+  Statement rows(db_, "SELECT part_type, count FROM stock WHERE buffer = ?");
+  rows.bind(buffer);
+  while (rows.step()) counts[rows.text(0)] = static_cast<int>(rows.integer(1));
+  t.commit();
+  return counts;
+}
+
+void CellStore::give(const std::string& buffer, const std::string& type, const std::string& order,
+                     const std::string& part, const std::string& carrier) {
+  Transaction t(*this);
+  Statement take(db_, "UPDATE stock SET count = count - 1 WHERE buffer = ? AND part_type = ? AND count > 0");
+  take.bind(buffer, type).step();
+  if (sqlite3_changes(db_) != 1) throw StoreError("buffer " + buffer + " has no " + type + " in its stored stock");
+  // A part given back earlier may be handed out again under the same name.
+  Statement put(db_,
+                "INSERT INTO parts(order_id, part, part_type, buffer, place, holder) VALUES(?, ?, ?, ?, 'in_transit', ?) "
+                "ON CONFLICT(order_id, part) DO UPDATE SET part_type = excluded.part_type, buffer = excluded.buffer, "
+                "place = 'in_transit', holder = excluded.holder, station = '' WHERE place = 'returned'");
+  put.bind(order, part, type, buffer, carrier).step();
+  if (sqlite3_changes(db_) != 1) throw StoreError("part " + part + " of order " + order + " was handed out already");
+  t.commit();
+}
+
+void CellStore::move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
+                          const char* from) {
+  Transaction t(*this);
+  Statement(db_, "UPDATE parts SET place = ?, holder = ? WHERE order_id = ? AND part = ? AND place = ?")
+      .bind(place_name(to), holder, order, part, from)
+      .step();
+  if (sqlite3_changes(db_) != 1) {
+    // The part was not where this move starts (handed out before the cell kept state, or
+    // moved by a process that was killed before it could say so): the journal tells.
+    t.commit();
+    journal(holder, std::string("unexpected ") + place_name(to), order, part + " was not " + from);
+    return;
+  }
+  t.commit();
+}
+
+void CellStore::deliver(const std::string& order, const std::string& part, const std::string& station) {
+  Transaction t(*this);
+  Statement(db_, "UPDATE parts SET place = 'on_station', holder = '', station = ? "
+                 "WHERE order_id = ? AND part = ? AND place = 'in_transit'")
+      .bind(station, order, part)
+      .step();
+  const bool moved = sqlite3_changes(db_) == 1;
+  t.commit();
+  if (!moved) journal(station, "unexpected on_station", order, part + " was not in_transit");
+}
+
+void CellStore::grip(const std::string& order, const std::string& part, const std::string& arm) {
+  move_part(order, part, Place::in_gripper, arm, "on_station");
+}
+
+void CellStore::release(const std::string& order, const std::string& part) {
+  move_part(order, part, Place::on_station, "", "in_gripper");
+}
+
+void CellStore::assemble(const std::string& order) {
+  Transaction t(*this);
+  Statement(db_, "UPDATE parts SET place = 'assembled', holder = '' WHERE order_id = ? AND place = 'on_station'")
+      .bind(order)
+      .step();
+  t.commit();
+}
+
+std::vector<PartRecord> CellStore::return_carried(const std::string& carrier) {
+  Transaction t(*this);
+  std::vector<PartRecord> carried = parts();
+  carried.erase(std::remove_if(carried.begin(), carried.end(),
+                               [&](const PartRecord& p) { return p.place != Place::in_transit || p.holder != carrier; }),
+                carried.end());
+  for (const auto& p : carried) {
+    Statement(db_, "UPDATE stock SET count = count + 1 WHERE buffer = ? AND part_type = ?").bind(p.buffer, p.part_type).step();
+    Statement(db_, "UPDATE parts SET place = 'returned', holder = '' WHERE order_id = ? AND part = ?")
+        .bind(p.order, p.part)
+        .step();
+    Statement(db_, "INSERT INTO journal(time, source, event, order_id, detail) VALUES(?, ?, 'returned', ?, ?)")
+        .bind(unix_now(), carrier, p.order, p.part + " (" + p.part_type + ") back to " + p.buffer)
+        .step();
+  }
+  t.commit();
+  return carried;
+}
+
+std::vector<PartRecord> CellStore::hold_for_inspection(const std::string& holder) {
+  Transaction t(*this);
+  std::vector<PartRecord> held = parts();
+  held.erase(std::remove_if(held.begin(), held.end(),
+                            [&](const PartRecord& p) { return p.place != Place::in_gripper || p.holder != holder; }),
+             held.end());
+  for (const auto& p : held) {
+    Statement(db_, "UPDATE parts SET place = 'inspection' WHERE order_id = ? AND part = ?").bind(p.order, p.part).step();
+    Statement(db_, "INSERT INTO journal(time, source, event, order_id, detail) VALUES(?, ?, 'inspection', ?, ?)")
+        .bind(unix_now(), holder, p.order, p.part + " (" + p.part_type + ") was in " + holder + "'s gripper")
+        .step();
+  }
+  t.commit();
+  return held;
+}
+
+std::map<std::string, PartCount> CellStore::inventory() const {
+  Transaction t(*this, "BEGIN");  // one snapshot for both tables
+  std::map<std::string, PartCount> out;
+  Statement stock(db_, "SELECT part_type, SUM(initial), SUM(count) FROM stock GROUP BY part_type");
+  while (stock.step()) {
+    PartCount& c = out[stock.text(0)];
+    c.initial = static_cast<int>(stock.integer(1));
+    c.in_buffers = static_cast<int>(stock.integer(2));
+  }
+  Statement parts(db_, "SELECT part_type, place, COUNT(*) FROM parts WHERE place != 'returned' GROUP BY part_type, place");
+  while (parts.step()) {
+    PartCount& c = out[parts.text(0)];
+    const int n = static_cast<int>(parts.integer(2));
+    switch (place_of(parts.text(1))) {
+      case Place::in_transit: c.in_transit += n; break;
+      case Place::on_station:
+      case Place::in_gripper: c.on_stations += n; break;
+      case Place::assembled: c.assembled += n; break;
+      case Place::inspection: c.inspection += n; break;
+      case Place::returned: break;
+    }
+  }
+  t.commit();
+  return out;
+}
+
+std::vector<PartRecord> CellStore::parts(const std::string& order) const {
+  Statement rows(db_, "SELECT order_id, part, part_type, buffer, place, holder FROM parts WHERE ? = '' OR order_id = ? "
+                      "ORDER BY order_id, part");
+  rows.bind(order, order);
+  std::vector<PartRecord> out;
+  while (rows.step()) {
+    out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(5), place_of(rows.text(4))});
+  }
+  return out;
+}
+
+void CellStore::command_taken(const CommandRecord& c) {
+  Statement(db_, "INSERT OR REPLACE INTO commands(resource, command_id, order_id, operation, part) VALUES(?, ?, ?, ?, ?)")
+      .bind(c.resource, c.command_id, c.order, c.operation, c.part)
+      .step();
+}
+
+void CellStore::command_ended(const std::string& resource, const std::string& command_id) {
+  Statement(db_, "DELETE FROM commands WHERE resource = ? AND command_id = ?").bind(resource, command_id).step();
+}
+
+std::vector<CommandRecord> CellStore::take_interrupted(const std::string& resource) {
+  Transaction t(*this);
+  Statement row(db_, "SELECT command_id, order_id, operation, part FROM commands WHERE resource = ? ORDER BY rowid");
+  row.bind(resource);
+  std::vector<CommandRecord> out;
+  while (row.step()) out.push_back({resource, row.text(0), row.text(1), row.text(2), row.text(3)});
+  Statement(db_, "DELETE FROM commands WHERE resource = ?").bind(resource).step();
+  t.commit();
+  return out;
+}
+
+void CellStore::set_bookings(const std::string& resource, const std::vector<BookingRecord>& bookings) {
+  Transaction t(*this);
+  Statement(db_, "DELETE FROM bookings WHERE resource = ?").bind(resource).step();
+  for (std::size_t i = 0; i < bookings.size(); ++i) {
+    const BookingRecord& b = bookings[i];
+    for (const auto& call : b.calls) {
+      Statement(db_, "INSERT INTO bookings(resource, position, order_id, holds, duration, call_id) VALUES(?, ?, ?, ?, ?, ?)")
+          .bind(resource, static_cast<long>(i), b.order, b.holds ? 1 : 0, b.duration, call)
+          .step();
+    }
+  }
+  t.commit();
+}
+
+std::vector<BookingRecord> CellStore::bookings(const std::string& resource) const {
+  Statement rows(db_, "SELECT position, order_id, holds, duration, call_id FROM bookings WHERE resource = ? "
+                      "ORDER BY position, call_id");
+  rows.bind(resource);
+  std::vector<BookingRecord> out;
+  long position = -1;
+  while (rows.step()) {
+    if (rows.integer(0) != position) {
+      position = rows.integer(0);
+      out.push_back({rows.text(1), {}, rows.real(3), rows.integer(2) != 0});
+    }
+    out.back().calls.push_back(rows.text(4));
+  }
+  return out;
+}
+
+std::map<std::string, std::string> CellStore::holders() const {
+  Statement rows(db_, "SELECT DISTINCT resource, order_id FROM bookings WHERE holds = 1");
+  std::map<std::string, std::string> out;
+  while (rows.step()) out[rows.text(0)] = rows.text(1);
+  return out;
+}
+
+bool CellStore::submit_order(const OrderRecord& o) {
+  Statement(db_, "INSERT OR IGNORE INTO orders(order_id, state, updated, product, out_dir, sequence, path_planner) "
+                 "VALUES(?, 'SUBMITTED', ?, ?, ?, ?, ?)")
+      .bind(o.order, unix_now(), o.product, o.out, o.sequence, o.path)
+      .step();
+  return sqlite3_changes(db_) == 1;
+}
+
+void CellStore::set_order(const std::string& order, const std::string& state, const std::string& reason, int exit_code) {
+  Statement(db_, "INSERT INTO orders(order_id, state, reason, updated, exit_code) VALUES(?, ?, ?, ?, NULLIF(?, -1)) "
+                 "ON CONFLICT(order_id) DO UPDATE SET state = excluded.state, reason = excluded.reason, "
+                 "updated = excluded.updated, exit_code = excluded.exit_code")
+      .bind(order, state, reason, unix_now(), exit_code)
+      .step();
+}
+
+int CellStore::count_attempt(const std::string& order) {
+  Transaction t(*this);
+  Statement(db_, "UPDATE orders SET attempts = attempts + 1 WHERE order_id = ?").bind(order).step();
+  Statement n(db_, "SELECT attempts FROM orders WHERE order_id = ?");
+  n.bind(order);
+  const int attempts = n.step() ? static_cast<int>(n.integer(0)) : 0;
+  t.commit();
+  return attempts;
+}
+
+std::vector<OrderRecord> CellStore::orders() const {
+  Statement rows(db_, "SELECT order_id, state, reason, product, out_dir, sequence, path_planner, IFNULL(exit_code, -1), "
+                      "attempts FROM orders ORDER BY order_id");
+  std::vector<OrderRecord> out;
+  while (rows.step()) {
+    out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(4), rows.text(5), rows.text(6),
+                   static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8))});
+  }
+  return out;
+}
+
+bool OrderRecord::ended() const { return state == "DONE" || state == "FAILED"; }
+
+void CellStore::journal(const std::string& source, const std::string& event, const std::string& order,
+                        const std::string& detail) {
+  Statement(db_, "INSERT INTO journal(time, source, event, order_id, detail) VALUES(?, ?, ?, ?, ?)")
+      .bind(unix_now(), source, event, order, detail)
+      .step();
+}
+
+std::vector<JournalEntry> CellStore::journal_since(long seq) const {
+  Statement rows(db_, "SELECT seq, time, source, event, order_id, detail FROM journal WHERE seq > ? ORDER BY seq");
+  rows.bind(seq);
+  std::vector<JournalEntry> out;
+  while (rows.step()) out.push_back({rows.integer(0), rows.real(1), rows.text(2), rows.text(3), rows.text(4), rows.text(5)});
+  return out;
+}
+
+int CellStore::count_events(const std::string& source, const std::string& event) const {
+  Statement n(db_, "SELECT COUNT(*) FROM journal WHERE source = ? AND event = ?");
+  n.bind(source, event).step();
+  return static_cast<int>(n.integer(0));
+}
+
+std::string CellStore::integrity() const {
+  Statement check(db_, "PRAGMA integrity_check");
+  std::string out;
+  while (check.step()) out += (out.empty() ? "" : "; ") + check.text(0);
+  return out;
+}
+
+}  // namespace state

@@ -1,0 +1,146 @@
+#pragma once
+// The cell's durable state, in one SQLite database (`<state_dir>/cell.db`) that every process
+// of the cell opens: the stock of each buffer, where every part handed out is, the command a
+// resource was executing, which order holds which exclusive resource, the orders' states,
+// and a journal of what happened. Why SQLite and not Fast DDS's persistence service:
+// docs/durable-state.md.
+//
+// Every change is one short transaction (BEGIN IMMEDIATE ... COMMIT, in WAL mode with
+// synchronous=FULL): a process killed at any moment leaves either all of a change or none
+// of it, and a part moves from one place to the next in the same transaction that takes it
+// from the last, so that for every part type, at every moment,
+//
+//   initial stock = in buffers + assembled + on stations + in transit + held for inspection.
+//
+// A part on its way is named by its order and its body in cell-sim (the command's `part`).
+// The store knows no products: part types and places are names.
+
+#include <sqlite3.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace state {
+
+// Where a part handed out by a buffer is.
+enum class Place { in_transit, on_station, in_gripper, assembled, inspection, returned };
+const char* place_name(Place p);
+
+struct PartCount {
+  int initial = 0, in_buffers = 0, assembled = 0, on_stations = 0, in_transit = 0, inspection = 0;
+  int accounted() const { return in_buffers + assembled + on_stations + in_transit + inspection; }
+};
+
+struct PartRecord {
+  std::string order, part, part_type, buffer, holder;
+  Place place = Place::in_transit;
+};
+
+// What a resource has taken on for an order: the awards (calls) it confirmed; `holds`: the
+// order holds the (exclusive) resource, rather than waiting for it or having work queued.
+struct BookingRecord {
+  std::string order;
+  std::vector<std::string> calls;
+  double duration = 0;
+  bool holds = false;
+};
+
+struct CommandRecord {
+  std::string resource, command_id, order, operation, part;
+};
+
+// An order as the cell's order desk keeps it: what to build (the product file, the output
+// folder, the planners), its state as its twin last said, and the twin's exit code once it
+// ended (-1 before). `attempts`: the twins started for it.
+struct OrderRecord {
+  std::string order, state, reason, product, out, sequence, path;
+  int exit_code = -1;
+  int attempts = 0;
+  bool ended() const;  // DONE or FAILED
+};
+
+struct JournalEntry {
+  long seq = 0;
+  double time = 0;  // Unix time, s
+  std::string source, event, order, detail;
+};
+
+class StoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class CellStore {
+ public:
+  // Opens (creating the folder, the file and the tables where missing) `dir/cell.db`.
+  explicit CellStore(const std::filesystem::path& dir);
+  ~CellStore();
+  CellStore(const CellStore&) = delete;
+  CellStore& operator=(const CellStore&) = delete;
+
+  static std::filesystem::path file_in(const std::filesystem::path& dir) { return dir / "cell.db"; }
+
+  // Inventory. `seed` is the deployment file's stock: a buffer seen the first time starts
+  // from it; afterwards the stored counts are the truth. Returns the counts now.
+  std::map<std::string, int> open_buffer(const std::string& buffer, const std::map<std::string, int>& seed);
+  // One part of `type` leaves `buffer` for `order` (its body `part`), carried by `carrier`.
+  // Throws StoreError when the buffer has none.
+  void give(const std::string& buffer, const std::string& type, const std::string& order, const std::string& part,
+            const std::string& carrier);
+  // The part reached `station` (a robot put it down at its dock).
+  void deliver(const std::string& order, const std::string& part, const std::string& station);
+  void grip(const std::string& order, const std::string& part, const std::string& arm);
+  void release(const std::string& order, const std::string& part);
+  // The order's product is finished: its parts on the station become assembled.
+  void assemble(const std::string& order);
+  // A carrier (a robot) that restarted gives what it carried back to the buffers it came
+  // from; an arm that restarted leaves what it gripped for inspection. Each returns the
+  // parts it moved, as they were.
+  std::vector<PartRecord> return_carried(const std::string& carrier);
+  std::vector<PartRecord> hold_for_inspection(const std::string& holder);
+
+  std::map<std::string, PartCount> inventory() const;
+  std::vector<PartRecord> parts(const std::string& order = "") const;
+
+  // The commands a resource has taken on (queued or under way), so that the process that
+  // follows a crash can answer them.
+  void command_taken(const CommandRecord& command);
+  void command_ended(const std::string& resource, const std::string& command_id);
+  // The commands the resource had taken on when its last process ended, taken out.
+  std::vector<CommandRecord> take_interrupted(const std::string& resource);
+
+  // What a resource has taken on, in its order (the holder first), replacing what was.
+  void set_bookings(const std::string& resource, const std::vector<BookingRecord>& bookings);
+  std::vector<BookingRecord> bookings(const std::string& resource) const;
+  // Resource -> the order that holds it.
+  std::map<std::string, std::string> holders() const;
+
+  // A new order, SUBMITTED; false when an order of that id exists.
+  bool submit_order(const OrderRecord& order);
+  void set_order(const std::string& order, const std::string& state, const std::string& reason = "", int exit_code = -1);
+  // One more twin started for the order; the attempts so far.
+  int count_attempt(const std::string& order);
+  std::vector<OrderRecord> orders() const;
+
+  void journal(const std::string& source, const std::string& event, const std::string& order = "",
+               const std::string& detail = "");
+  std::vector<JournalEntry> journal_since(long seq = 0) const;
+  int count_events(const std::string& source, const std::string& event) const;
+
+  // "ok", or what PRAGMA integrity_check found.
+  std::string integrity() const;
+
+ private:
+  class Statement;
+  class Transaction;
+  void exec(const char* sql) const;
+  void move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
+                 const char* from);
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace state

@@ -1,0 +1,175 @@
+// The cell's durable state: stock that survives a restart, parts that move from place to
+// place without ever being lost or counted twice, commands a restarted resource answers, and
+// a database that a SIGKILL in the middle of writing leaves whole.
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <random>
+#include <thread>
+
+#include "services/state/cell_store.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("agile-cell-store-" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+void require_conserved(const state::CellStore& store) {
+  for (const auto& [type, c] : store.inventory()) {
+    INFO(type << ": initial " << c.initial << ", in buffers " << c.in_buffers << ", assembled " << c.assembled
+              << ", on stations " << c.on_stations << ", in transit " << c.in_transit << ", inspection " << c.inspection);
+    REQUIRE(c.initial == c.accounted());
+  }
+}
+
+}  // namespace
+
+TEST_CASE("a buffer's stock is seeded once; afterwards the stored counts are the truth", "[state]") {
+  const fs::path dir = fresh_dir("seed");
+  {
+    state::CellStore store(dir);
+    CHECK(store.open_buffer("buffer-1", {{"Peg", 3}}) == std::map<std::string, int>{{"Peg", 3}});
+    store.give("buffer-1", "Peg", "o1", "o1/peg-1", "robot-1");
+  }
+  state::CellStore again(dir);  // a restarted buffer, its deployment file unchanged
+  CHECK(again.open_buffer("buffer-1", {{"Peg", 3}}) == std::map<std::string, int>{{"Peg", 2}});
+  CHECK(again.inventory().at("Peg").initial == 3);
+  CHECK(again.integrity() == "ok");
+}
+
+TEST_CASE("a part moves buffer, robot, station, gripper, product, and is counted once at every step", "[state]") {
+  state::CellStore store(fresh_dir("moves"));
+  store.open_buffer("buffer-1", {{"Peg", 2}, {"Plate", 1}});
+  const auto count = [&](const std::string& type) { return store.inventory().at(type); };
+
+  store.give("buffer-1", "Peg", "o1", "o1/peg", "robot-1");
+  CHECK(count("Peg").in_transit == 1);
+  CHECK(count("Peg").in_buffers == 1);
+  require_conserved(store);
+  store.deliver("o1", "o1/peg", "station-1");
+  CHECK(count("Peg").on_stations == 1);
+  store.grip("o1", "o1/peg", "arm-1");
+  CHECK(count("Peg").on_stations == 1);  // in the gripper, at the station
+  CHECK(store.parts("o1").front().place == state::Place::in_gripper);
+  store.release("o1", "o1/peg");
+  store.assemble("o1");
+  CHECK(count("Peg").assembled == 1);
+  CHECK(count("Peg").on_stations == 0);
+  require_conserved(store);
+
+  SECTION("a buffer that has none refuses, and nothing changes") {
+    store.give("buffer-1", "Plate", "o2", "o2/plate", "robot-1");
+    CHECK_THROWS_WITH(store.give("buffer-1", "Plate", "o2", "o2/plate-2", "robot-1"),
+                      Catch::Contains("buffer-1 has no Plate"));
+    CHECK(store.parts("o2").size() == 1);
+    require_conserved(store);
+  }
+  SECTION("the same part is never handed out twice") {
+    CHECK_THROWS_WITH(store.give("buffer-1", "Peg", "o1", "o1/peg", "robot-1"), Catch::Contains("handed out already"));
+    CHECK(count("Peg").in_buffers == 1);
+  }
+  SECTION("a robot that restarts gives its load back; an arm that restarts leaves its part for inspection") {
+    store.give("buffer-1", "Peg", "o2", "o2/peg", "robot-1");
+    store.give("buffer-1", "Plate", "o2", "o2/plate", "robot-2");
+    store.deliver("o2", "o2/plate", "station-1");
+    store.grip("o2", "o2/plate", "arm-1");
+    const auto returned = store.return_carried("robot-1");
+    REQUIRE(returned.size() == 1);
+    CHECK(returned.front().part == "o2/peg");
+    CHECK(count("Peg").in_buffers == 1);
+    const auto held = store.hold_for_inspection("arm-1");
+    REQUIRE(held.size() == 1);
+    CHECK(count("Plate").inspection == 1);
+    require_conserved(store);
+    // A part given back may be handed out again under its name.
+    store.give("buffer-1", "Peg", "o2", "o2/peg", "robot-1");
+    CHECK(count("Peg").in_transit == 1);
+    require_conserved(store);
+  }
+}
+
+TEST_CASE("the commands a resource had taken on are answered once by the process after it", "[state]") {
+  state::CellStore store(fresh_dir("commands"));
+  store.command_taken({"robot-1", "o1/c1", "o1", "fetch", "o1/peg"});
+  store.command_taken({"robot-1", "o1/c2", "o1", "fetch", "o1/plate"});
+  store.command_taken({"arm-1", "o1/c3", "o1", "grip", "o1/peg"});
+  store.command_ended("robot-1", "o1/c1");
+  const auto interrupted = store.take_interrupted("robot-1");
+  REQUIRE(interrupted.size() == 1);
+  CHECK(interrupted.front().command_id == "o1/c2");
+  CHECK(store.take_interrupted("robot-1").empty());
+  CHECK(store.take_interrupted("arm-1").size() == 1);
+}
+
+TEST_CASE("bookings, orders and the journal", "[state]") {
+  state::CellStore store(fresh_dir("holds"));
+  store.set_bookings("station-1", {{"o1", {"o1/host"}, 40, true}, {"o2", {"o2/host", "o2/host-2"}, 30, false}});
+  store.set_bookings("arm-1", {{"o1", {"o1/arm"}, 40, true}});
+  store.set_bookings("arm-1", {});
+  store.set_bookings("robot-1", {{"o1", {"o1/fetch"}, 0, false}});
+  CHECK(store.holders() == std::map<std::string, std::string>{{"station-1", "o1"}});
+  const auto station = store.bookings("station-1");
+  REQUIRE(station.size() == 2);
+  CHECK(station[1].order == "o2");
+  CHECK(station[1].calls == std::vector<std::string>{"o2/host", "o2/host-2"});
+  CHECK(station[1].duration == 30);
+  CHECK_FALSE(station[1].holds);
+  store.set_order("o1", "PLANNING");
+  store.set_order("o1", "FAILED", "arm-1 restarted");
+  REQUIRE(store.orders().size() == 1);
+  CHECK(store.orders().front().reason == "arm-1 restarted");
+  store.journal("buffer-1", "restarted");
+  store.journal("buffer-1", "restarted");
+  CHECK(store.count_events("buffer-1", "restarted") == 2);
+  CHECK(store.journal_since(1).size() == 1);
+}
+
+// Writers in other processes, killed with SIGKILL at random moments while they give parts:
+// every give either happened whole (the stock one less and the part in transit) or not at all.
+TEST_CASE("SIGKILL in the middle of writing loses nothing committed and corrupts nothing", "[state][processes]") {
+  const fs::path dir = fresh_dir("crash");
+  constexpr int kStock = 100000;
+  state::CellStore(dir).open_buffer("buffer-1", {{"Peg", kStock}});
+  std::mt19937 random(7);
+  int part = 0;
+  for (int round = 0; round < 12; ++round) {
+    std::vector<pid_t> writers;
+    for (int w = 0; w < 2; ++w) {
+      const int first = (part += 100000);
+      const pid_t pid = ::fork();
+      REQUIRE(pid >= 0);
+      if (pid == 0) {
+        try {
+          state::CellStore store(dir);
+          for (int i = first;; ++i) store.give("buffer-1", "Peg", "o", "p" + std::to_string(i), "robot-1");
+        } catch (...) {
+          ::_exit(1);
+        }
+      }
+      writers.push_back(pid);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20 + random() % 80));
+    for (pid_t pid : writers) {
+      ::kill(pid, SIGKILL);
+      int status = 0;
+      ::waitpid(pid, &status, 0);
+      CHECK(WIFSIGNALED(status));  // killed while writing, not ended by an error
+    }
+  }
+  state::CellStore store(dir);
+  CHECK(store.integrity() == "ok");
+  const auto peg = store.inventory().at("Peg");
+  INFO("gives committed: " << peg.in_transit);
+  CHECK(peg.in_transit > 0);
+  CHECK(peg.in_transit == static_cast<int>(store.parts("o").size()));
+  CHECK(peg.initial == peg.accounted());
+}
