@@ -11,12 +11,13 @@ namespace dds {
 
 using OrderStatusSubscriber = SubscribeBlock<cell::OrderStatus, cell::OrderStatusPubSubType>;
 
-inline OrderStatusSubscriber& watch_orders(fb::Resource& resource, const ParticipantPtr& participant) {
+inline OrderStatusSubscriber& watch_orders(fb::Resource& resource, const ParticipantPtr& participant,
+                                           fb::OrderWatch::Resumable resumable = {}) {
   auto& orders = resource.add(std::make_unique<OrderStatusSubscriber>(
       "orders", participant, "cell/orders/status", TopicKind::state, [](const cell::OrderStatus& s) {
         return fb::Data{{"order_id", s.order_id().to_string()}, {"ended", s.state() == cell::DONE || s.state() == cell::FAILED}};
       }));
-  resource.add(std::make_unique<fb::OrderWatch>());
+  resource.add(std::make_unique<fb::OrderWatch>(std::move(resumable)));
   resource.connect("orders", "IND", "order_watch", "STATUS");
   resource.connect("orders", "GONE", "order_watch", "GONE");
   return orders;

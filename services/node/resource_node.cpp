@@ -75,6 +75,7 @@ struct ResourceNode::Impl {
   std::function<void(cell::Capability&)> describe;
   std::unique_ptr<state::CellStore> store;
   std::string recovered;  // what the device did with what its predecessor process held
+  std::chrono::steady_clock::time_point last_check;
   dds::SimClock clock;
   std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
   // Answers to commands the resource's queue had no room for, written on the listener thread.
@@ -280,6 +281,12 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   // Refusals counted on the listener thread while the queue was full, published once it is quiet.
   resource.on_idle([&n] {
     if (n.overflowed != n.overflowed_published) n.publish_capability();
+    // Now and then: has a suspended order ended, or waited too long for its twin?
+    const auto now = std::chrono::steady_clock::now();
+    if (n.store && now - n.last_check > std::chrono::seconds(1)) {
+      n.last_check = now;
+      n.resource.post("order_watch", "CHECK");
+    }
   });
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
       "cancels", "cell/cancel_requests", TopicKind::events,
@@ -312,7 +319,17 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
                                                   [](const cell::Award& a) { return dds::to_data(a); });
   n.subscribe<cell::Release, cell::ReleasePubSubType>("releases", "cell/negotiation/releases", TopicKind::events,
                                                       [](const cell::Release& r) { return dds::to_data(r); });
-  auto& orders = dds::watch_orders(resource, participant);
+  // With the cell's state, an order whose twin died waits for the twin the cell starts again.
+  fb::OrderWatch::Resumable resumable;
+  if (n.store) {
+    resumable = [&n](const std::string& order) {
+      for (const auto& o : n.store->orders()) {
+        if (o.order == order) return !o.ended() && !o.product.empty();  // the desk's, and not over
+      }
+      return false;
+    };
+  }
+  auto& orders = dds::watch_orders(resource, participant, std::move(resumable));
   n.starters.push_back([&orders] { orders.start(); });
   resource.connect("calls", "IND", "contractor", "CFP");
   resource.connect("awards", "IND", "contractor", "AWARD");

@@ -13,7 +13,8 @@ CREATE TABLE IF NOT EXISTS stock(
   PRIMARY KEY(buffer, part_type));
 CREATE TABLE IF NOT EXISTS parts(
   order_id TEXT NOT NULL, part TEXT NOT NULL, part_type TEXT NOT NULL, buffer TEXT NOT NULL,
-  place TEXT NOT NULL CHECK(place IN ('in_transit','on_station','in_gripper','assembled','inspection','returned')),
+  place TEXT NOT NULL CHECK(place IN ('in_transit','on_station','in_gripper','placed','assembled','inspection',
+                                     'returned')),
   holder TEXT NOT NULL DEFAULT '', station TEXT NOT NULL DEFAULT '',
   PRIMARY KEY(order_id, part));
 CREATE TABLE IF NOT EXISTS commands(
@@ -37,8 +38,8 @@ double unix_now() {
 }
 
 Place place_of(const std::string& name) {
-  for (Place p : {Place::in_transit, Place::on_station, Place::in_gripper, Place::assembled, Place::inspection,
-                  Place::returned}) {
+  for (Place p : {Place::in_transit, Place::on_station, Place::in_gripper, Place::placed, Place::assembled,
+                  Place::inspection, Place::returned}) {
     if (name == place_name(p)) return p;
   }
   throw StoreError("unknown place '" + name + "' in the parts table");
@@ -51,6 +52,7 @@ const char* place_name(Place p) {
     case Place::in_transit: return "in_transit";
     case Place::on_station: return "on_station";
     case Place::in_gripper: return "in_gripper";
+    case Place::placed: return "placed";
     case Place::assembled: return "assembled";
     case Place::inspection: return "inspection";
     case Place::returned: return "returned";
@@ -225,9 +227,17 @@ void CellStore::release(const std::string& order, const std::string& part) {
   move_part(order, part, Place::on_station, "", "in_gripper");
 }
 
+void CellStore::place(const std::string& order, const std::string& part) {
+  move_part(order, part, Place::placed, "", "on_station");
+}
+
+void CellStore::set_aside(const std::string& order, const std::string& part) {
+  move_part(order, part, Place::inspection, "", "in_gripper");
+}
+
 void CellStore::assemble(const std::string& order) {
   Transaction t(*this);
-  Statement(db_, "UPDATE parts SET place = 'assembled', holder = '' WHERE order_id = ? AND place = 'on_station'")
+  Statement(db_, "UPDATE parts SET place = 'assembled', holder = '' WHERE order_id = ? AND place IN ('on_station', 'placed')")
       .bind(order)
       .step();
   t.commit();
@@ -284,7 +294,8 @@ std::map<std::string, PartCount> CellStore::inventory() const {
     switch (place_of(parts.text(1))) {
       case Place::in_transit: c.in_transit += n; break;
       case Place::on_station:
-      case Place::in_gripper: c.on_stations += n; break;
+      case Place::in_gripper:
+      case Place::placed: c.on_stations += n; break;
       case Place::assembled: c.assembled += n; break;
       case Place::inspection: c.inspection += n; break;
       case Place::returned: break;
@@ -295,12 +306,13 @@ std::map<std::string, PartCount> CellStore::inventory() const {
 }
 
 std::vector<PartRecord> CellStore::parts(const std::string& order) const {
-  Statement rows(db_, "SELECT order_id, part, part_type, buffer, place, holder FROM parts WHERE ? = '' OR order_id = ? "
-                      "ORDER BY order_id, part");
+  Statement rows(db_, "SELECT order_id, part, part_type, buffer, place, holder, station FROM parts "
+                      "WHERE ? = '' OR order_id = ? ORDER BY order_id, part");
   rows.bind(order, order);
   std::vector<PartRecord> out;
   while (rows.step()) {
-    out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(5), place_of(rows.text(4))});
+    out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(5), place_of(rows.text(4)),
+                   rows.text(6)});
   }
   return out;
 }
@@ -323,6 +335,14 @@ std::vector<CommandRecord> CellStore::take_interrupted(const std::string& resour
   while (row.step()) out.push_back({resource, row.text(0), row.text(1), row.text(2), row.text(3)});
   Statement(db_, "DELETE FROM commands WHERE resource = ?").bind(resource).step();
   t.commit();
+  return out;
+}
+
+std::vector<CommandRecord> CellStore::commands_of(const std::string& order) const {
+  Statement rows(db_, "SELECT resource, command_id, operation, part FROM commands WHERE order_id = ?");
+  rows.bind(order);
+  std::vector<CommandRecord> out;
+  while (rows.step()) out.push_back({rows.text(0), rows.text(1), order, rows.text(2), rows.text(3)});
   return out;
 }
 

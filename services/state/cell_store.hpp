@@ -27,7 +27,9 @@
 namespace state {
 
 // Where a part handed out by a buffer is.
-enum class Place { in_transit, on_station, in_gripper, assembled, inspection, returned };
+// on_station: at the station's dock, delivered; placed: assembled into the product on the
+// station (not finished yet); in_gripper: the arm holds it. All three stand on the station.
+enum class Place { in_transit, on_station, in_gripper, placed, assembled, inspection, returned };
 const char* place_name(Place p);
 
 struct PartCount {
@@ -38,6 +40,7 @@ struct PartCount {
 struct PartRecord {
   std::string order, part, part_type, buffer, holder;
   Place place = Place::in_transit;
+  std::string station;  // where it was delivered
 };
 
 // What a resource has taken on for an order: the awards (calls) it confirmed; `holds`: the
@@ -95,6 +98,9 @@ class CellStore {
   void deliver(const std::string& order, const std::string& part, const std::string& station);
   void grip(const std::string& order, const std::string& part, const std::string& arm);
   void release(const std::string& order, const std::string& part);
+  // Assembled into the product on the station (its step is done); set aside for inspection.
+  void place(const std::string& order, const std::string& part);
+  void set_aside(const std::string& order, const std::string& part);
   // The order's product is finished: its parts on the station become assembled.
   void assemble(const std::string& order);
   // A carrier (a robot) that restarted gives what it carried back to the buffers it came
@@ -112,6 +118,8 @@ class CellStore {
   void command_ended(const std::string& resource, const std::string& command_id);
   // The commands the resource had taken on when its last process ended, taken out.
   std::vector<CommandRecord> take_interrupted(const std::string& resource);
+  // The commands of an order some resource has taken on and not ended.
+  std::vector<CommandRecord> commands_of(const std::string& order) const;
 
   // What a resource has taken on, in its order (the holder first), replacing what was.
   void set_bookings(const std::string& resource, const std::vector<BookingRecord>& bookings);

@@ -4,6 +4,8 @@
 
 #include <signal.h>
 
+#include <set>
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -129,4 +131,104 @@ TEST_CASE("kills mid-order: every part accounted for, stock kept across a restar
   CHECK(store.integrity() == "ok");
   CHECK(store.holders().empty());
   CHECK(store.count_events("mobile-robot-1", "restarted") == 1);
+}
+
+namespace {
+
+// Waits until `count` parts of the order stand in place; those parts.
+std::set<std::string> wait_for_placed(const fs::path& state_dir, const std::string& order, std::size_t count) {
+  state::CellStore store(state_dir);
+  std::set<std::string> placed;
+  const auto deadline = std::chrono::steady_clock::now() + 90s;
+  while (placed.size() < count && std::chrono::steady_clock::now() < deadline) {
+    placed.clear();
+    for (const auto& p : store.parts(order)) {
+      if (p.place == state::Place::placed) placed.insert(p.part);
+    }
+    std::this_thread::sleep_for(20ms);
+  }
+  return placed;
+}
+
+// Every part in place before stays the one assembled: none was fetched or placed again.
+void check_taken_up(const fs::path& state_dir, const std::string& order, const std::set<std::string>& placed_before) {
+  state::CellStore store(state_dir);
+  std::set<std::string> assembled, all;
+  for (const auto& p : store.parts(order)) {
+    all.insert(p.part);
+    if (p.place == state::Place::assembled) assembled.insert(p.part);
+  }
+  INFO("parts of " << order << ": " << all.size());
+  CHECK(assembled.size() == 11);  // the Lego tower
+  for (const auto& part : placed_before) {
+    INFO(part);
+    CHECK(assembled.count(part) == 1);
+    CHECK(all.count(part + "/r2") == 0);
+  }
+  bool taken_up = false;
+  for (const auto& e : store.journal_since(0)) taken_up |= e.order == order && e.event == "taken up";
+  CHECK(taken_up);
+  for (const auto& [type, c] : store.inventory()) CHECK(c.initial == c.accounted());
+}
+
+}  // namespace
+
+TEST_CASE("a twin killed during physical assembly is started again and finishes the order, no step done twice",
+          "[process][cell][state]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("twin-resume");
+  const fs::path state_dir = dir / "state", log = dir / "up.log";
+  const std::string domain = "197";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir",
+                         state_dir.string()},
+                        log.string());
+  REQUIRE(appears(log, "cell up on domain"));
+  test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
+                             domain, "--order", "tower", "--out", (dir / "tower").string()},
+                            (dir / "submit.log").string());
+  const auto placed = wait_for_placed(state_dir, "tower", 3);
+  REQUIRE(placed.size() >= 3);
+  const pid_t twin = test::child_with_argument(up.pid(), "tower");
+  REQUIRE(twin > 0);
+  ::kill(twin, SIGKILL);
+  const int code = submit.wait_for_exit(150s);
+  INFO(test::read_text(dir / "submit.log") << test::read_text(log));
+  CHECK(code == 0);
+  CHECK(test::read_text(log).find("order tower: twin started again (attempt 2)") != std::string::npos);
+  check_taken_up(state_dir, "tower", placed);
+  const json status = status_json(domain, dir);
+  for (const auto& r : status["resources"]) CHECK(r["reserved_by"] == "");
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("cellctl down pauses the orders under way, and up on the same state takes them up", "[process][cell][state]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("pause");
+  const fs::path state_dir = dir / "state";
+  const std::string domain = "198";
+  const std::vector<std::string> up_args{CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10",
+                                         "--state-dir", state_dir.string()};
+  auto up = std::make_unique<test::ChildProcess>(up_args, (dir / "up-1.log").string());
+  REQUIRE(appears(dir / "up-1.log", "cell up on domain"));
+  test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
+                             domain, "--order", "paused", "--out", (dir / "paused").string()},
+                            (dir / "submit.log").string());
+  const auto placed = wait_for_placed(state_dir, "paused", 2);
+  REQUIRE(placed.size() >= 2);
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down-1.log", 30s) == 0);
+  CHECK(up->wait_for_exit(20s) == 0);
+  {
+    state::CellStore store(state_dir);
+    const auto orders = store.orders();
+    REQUIRE(orders.size() == 1);
+    CHECK(orders.front().state == "INTERRUPTED");
+  }
+  up = std::make_unique<test::ChildProcess>(up_args, (dir / "up-2.log").string());
+  const int code = submit.wait_for_exit(150s);  // it follows the order across the pause
+  INFO(test::read_text(dir / "submit.log") << test::read_text(dir / "up-1.log") << test::read_text(dir / "up-2.log"));
+  CHECK(code == 0);
+  check_taken_up(state_dir, "paused", placed);
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down-2.log", 30s) == 0);
+  CHECK(up->wait_for_exit(20s) == 0);
 }

@@ -33,7 +33,7 @@ void require_conserved(const state::CellStore& store) {
 
 }  // namespace
 
-TEST_CASE("a buffer's stock is seeded once; afterwards the stored counts are the truth", "[state]") {
+TEST_CASE("a buffer's stock is seeded once, and from then on the stored counts are the truth", "[state]") {
   const fs::path dir = fresh_dir("seed");
   {
     state::CellStore store(dir);

@@ -43,6 +43,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
+  declare_output("PLACED", {"part"});
   declare_output("FINISHED", {"complete", "error"});
 
   const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
@@ -93,6 +94,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     transition(in, "SIM_REPLY", in, [this](const Data& d) {
       if (!action_running_ || get<std::string>(d, "request_id") != awaited_id_) return;
       if (state() == "CLEANUP") return action_done();
+      if (!get<bool>(d, "ok") && actions_.front().may_fail) return action_done();
       if (!get<bool>(d, "ok")) return fail("cell-sim refused: " + get<std::string>(d, "error"));
       if (fb::get_or<bool>(d, "collided", false) && actions_.front().retry_on_collision) {
         std::string reason;
@@ -184,11 +186,13 @@ double OrderOrchestrator::physical_estimate() const {
   return length / settings_.arm_speed;
 }
 
-void OrderOrchestrator::book(const std::string& only) {
+void OrderOrchestrator::book(std::string only) {
+  if (only.empty()) only = settings_.resume.station;  // its parts stand there
   enter("BOOKING");
   ahead_ = -1;
   waiting_since_ = std::chrono::steady_clock::now();
-  status("WAITING", only.empty() ? "virtual assembly done; booking a station" : "booking " + only + ", whose queue is shorter", 0);
+  const std::string why = only == settings_.resume.station ? ", where its parts stand" : ", whose queue is shorter";
+  status("WAITING", only.empty() ? "virtual assembly done; booking a station" : "booking " + only + why, 0);
   emit("CALL", {{"call_id", settings_.order_id + "/" + kHost}, {"operation", kHost}, {"part_type", std::string()},
                 {"station", only}, {"sources", std::string()}, {"count", std::int64_t(0)},
                 {"duration", physical_estimate()}});
@@ -197,6 +201,7 @@ void OrderOrchestrator::book(const std::string& only) {
 // Orders booked at the same moment see the same bids and may crowd one station: an order
 // that waits moves to another station whose queue is shorter by two or more, or that is free.
 void OrderOrchestrator::consider_moving_to(const std::string& station) {
+  if (!settings_.resume.station.empty()) return;
   const Place& p = places_.at(station);
   const long load = (p.reserved_by.empty() ? 0 : 1) + static_cast<long>(p.waiting.size());
   if (ahead_ < 1 || !(load == 0 || load + 1 < ahead_)) return;
@@ -336,7 +341,8 @@ std::string OrderOrchestrator::physical_body(PartIndex part) const {
 }
 
 Data OrderOrchestrator::command(const std::string& resource, const std::string& operation, const std::string& part) {
-  return {{"command_id", settings_.order_id + "/" + std::to_string(++command_count_) + "/" + operation},
+  const std::string attempt = settings_.resume.attempt > 1 ? "r" + std::to_string(settings_.resume.attempt) + "/" : "";
+  return {{"command_id", settings_.order_id + "/" + attempt + std::to_string(++command_count_) + "/" + operation},
           {"resource_id", resource}, {"order_id", settings_.order_id}, {"operation", operation}, {"part", part},
           {"award", award_of_[resource]}};
 }
@@ -437,19 +443,50 @@ void OrderOrchestrator::add_arm_moves(const std::string& body, const std::vector
 }
 
 void OrderOrchestrator::plan_physical() {
-  status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_, 0);
+  const auto& resume = settings_.resume;
+  status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ +
+                                  (resume.used.empty() ? "" : " (taken up again: " + std::to_string(resume.placed.size()) +
+                                                                  " parts in place, " +
+                                                                  std::to_string(resume.delivered.size()) + " at the dock)"),
+         0);
   const Numbers& dock = places_.at(station_).dock;
-  std::vector<std::string> fetches;
-  for (const auto& step : plan_.steps) {
+  // A part set aside (or given back) by the earlier attempt leaves the scene; a new one comes.
+  for (const auto& body : resume.used) {
+    if (!resume.placed.count(body) && !resume.delivered.count(body)) {
+      actions_.push_back({Action::sim, sim_.remove(body), false, true});
+    }
+  }
+  std::vector<std::string> fetches, bodies;
+  std::vector<std::size_t> steps;  // the steps to do
+  for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
+    const auto& step = plan_.steps[i];
     const auto& part = product_.product.parts()[step.part];
     const std::string type = short_type_name(part.type);
+    const Pose final_pose = at(station_, part.final_pose);
+    std::string body = physical_body(step.part);
+    const std::string mesh = part.mesh->file.string();
+    if (resume.placed.count(body)) {  // done: it stands in the product
+      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({final_pose}), {0, 0, 0}, true, mesh)});
+      spawned_.insert(body);
+      continue;
+    }
+    steps.push_back(i);
+    if (resume.delivered.count(body)) {  // at the dock, where a robot put it down
+      const Pose at_dock = with_translation(final_pose, dock[0], final_pose.translation().y(), dock[2]);
+      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at_dock}), {0, 0, 0}, false, mesh)});
+      spawned_.insert(body);
+      fetches.push_back("delivered/" + body);
+      delivered_.insert(fetches.back());
+      bodies.push_back(body);
+      continue;
+    }
+    if (resume.used.count(body)) body += "/r" + std::to_string(resume.attempt);  // the first was set aside
     const std::string& buffer = buffer_of_.at(type);
     const Numbers& source = places_.at(buffer).dock;
-    const Pose final_pose = at(station_, part.final_pose);
-    const std::string body = physical_body(step.part);
     const Pose in_buffer = with_translation(final_pose, source[0], final_pose.translation().y(), source[2]);
-    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, part.mesh->file.string())});
+    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, mesh)});
     spawned_.insert(body);
+    bodies.push_back(body);
     Data fetch = command(robot_, "fetch", body);
     fetch["part_type"] = type;
     fetch["source"] = buffer;
@@ -459,12 +496,12 @@ void OrderOrchestrator::plan_physical() {
     fetches.push_back(get<std::string>(fetch, "command_id"));
     actions_.push_back({Action::send_only, fetch});
   }
-  for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
-    const PartIndex part = plan_.steps[i].part;
-    const Trajectory& t = plan_.steps[i].trajectory;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const PartIndex part = plan_.steps[steps[k]].part;
+    const Trajectory& t = plan_.steps[steps[k]].trajectory;
     const auto& w = t.waypoints;
-    const std::string body = physical_body(part);
-    actions_.push_back({Action::await_delivery, {{"command_id", fetches[i]}}});
+    const std::string& body = bodies[k];
+    actions_.push_back({Action::await_delivery, {{"command_id", fetches[k]}}});
     // Delivered at the dock; carried up, over to where the trajectory starts, then along it.
     const Pose grip = w.front().part.inverse() * w.front().gripper;
     const Pose start = at(station_, w.front().part);
@@ -553,6 +590,7 @@ void OrderOrchestrator::next_action() {
 void OrderOrchestrator::action_done() {
   const Action& a = actions_.front();
   if (state() == "PHYSICAL" && a.kind == Action::command && get<std::string>(a.data, "operation") == "connect") {
+    emit("PLACED", {{"part", get<std::string>(a.data, "part")}});
     const std::size_t left = std::count_if(actions_.begin(), actions_.end(), [](const Action& x) {
       return x.kind == Action::await_delivery;
     });

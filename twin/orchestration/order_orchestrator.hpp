@@ -38,7 +38,8 @@
 //           order_id, state, reason), SIM_REPLY (request_id, ok, error, collided, ...)
 //   outputs: CALL (to the Negotiator), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
-//            FINDING (kind, message, part), FINISHED (complete, error)
+//            FINDING (kind, message, part), PLACED (part: its body, assembled in place),
+//            FINISHED (complete, error)
 
 #include <chrono>
 #include <deque>
@@ -65,6 +66,16 @@ struct OrderSettings {
   double arm_speed = 0.25;          // m/s: virtual assembly's moves, until an arm's capability says
   double arm_angular_speed = 1.0;   // rad/s
   fb::GripperSize gripper;
+  // Taking up an order whose earlier twin ended during physical assembly, as the cell's
+  // state left it: the order books the station its parts stand on, and its steps done are
+  // not done again.
+  struct Resume {
+    int attempt = 1;                  // this twin's, for command ids of its own
+    std::string station;              // where its parts stand ("": nowhere)
+    std::set<std::string> placed;     // bodies assembled at their final poses
+    std::set<std::string> delivered;  // bodies at the station's dock, not assembled yet
+    std::set<std::string> used;       // every body handed out before: a part set aside needs a new one
+  } resume;
 };
 
 class OrderOrchestrator : public fb::BasicBlock {
@@ -83,6 +94,7 @@ class OrderOrchestrator : public fb::BasicBlock {
     enum Kind { sim, command, send_only, await_delivery } kind;
     fb::Data data;
     bool retry_on_collision = false;  // a move of a candidate trajectory in virtual assembly
+    bool may_fail = false;            // a removal of a body that may be gone already
   };
   struct Place {
     std::string kind;
@@ -94,7 +106,7 @@ class OrderOrchestrator : public fb::BasicBlock {
 
   // Booking and hiring.
   void try_begin_virtual();
-  void book(const std::string& only = "");  // `only`: call that station alone
+  void book(std::string only = "");  // `only`: call that station alone
   void on_queue_news(const Place& station);
   void report_place(long ahead);  // "waiting for station-1: N orders ahead", when N changed
   void consider_moving_to(const std::string& station);

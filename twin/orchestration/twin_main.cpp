@@ -5,7 +5,9 @@
 //   twin --domain 42 --order o1 --product deploy/products/cranfield/cranfield.aml --out out/o1
 // Exit codes: 0 assembled, 1 the order failed, 2 bad input.
 
+#include <algorithm>
 #include <atomic>
+#include <thread>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -103,15 +105,7 @@ class TwinProcess {
   // Plans, then orchestrates; returns the exit code.
   int run() {
     status("SUBMITTED", options_.product, 0);
-    if (store_) {
-      // A twin before this one ended with parts handed out for the order: they stand where the
-      // store says, and this version does not take physical assembly up from the middle.
-      if (const auto parts = store_->parts(options_.order); !parts.empty()) {
-        return end_with(1, "its twin ended during physical assembly with " + std::to_string(parts.size()) +
-                               " parts handed out (`cellctl status` says where they are); clear the station, "
-                               "then submit the order again under a new id");
-      }
-    }
+    if (store_ && !take_up()) return end_with(1, "the work of its earlier twin did not end within 60 s");
     sim::MeshCache meshes;
     std::optional<twin::LoadedProduct> loaded;
     try {
@@ -144,6 +138,43 @@ class TwinProcess {
     std::cerr << "error: order " << options_.order << ": " << error << '\n';
     linger();
     return code;
+  }
+
+  // Where an earlier twin of the order left it (the cell's state): once the work it had
+  // given the resources has ended (a robot carries on with its fetches), the parts in place
+  // and at the dock are used as they are; one left in a gripper is set aside for inspection
+  // and fetched anew. False when that work did not end in time.
+  bool take_up() {
+    for (const auto& o : store_->orders()) {
+      if (o.order == options_.order) resume_.attempt = std::max(1, o.attempts);
+    }
+    if (store_->parts(options_.order).empty()) return true;
+    status("SUBMITTED", "taking the order up where its earlier twin left it", 0);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    const auto in_transit = [&] {
+      const auto parts = store_->parts(options_.order);
+      return std::any_of(parts.begin(), parts.end(), [](const auto& p) { return p.place == state::Place::in_transit; });
+    };
+    while (!store_->commands_of(options_.order).empty() || in_transit()) {
+      if (std::chrono::steady_clock::now() > deadline || !running) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    for (const auto& p : store_->parts(options_.order)) {
+      resume_.used.insert(p.part);
+      if (p.place == state::Place::in_gripper) {
+        store_->set_aside(options_.order, p.part);
+        store_->journal("twin-" + options_.order, "inspection", options_.order, p.part + " was in " + p.holder + "'s gripper");
+      }
+      if (p.place == state::Place::placed) resume_.placed.insert(p.part);
+      if (p.place == state::Place::on_station) resume_.delivered.insert(p.part);
+      if (p.place == state::Place::placed || p.place == state::Place::on_station || p.place == state::Place::in_gripper) {
+        resume_.station = p.station;
+      }
+    }
+    store_->journal("twin-" + options_.order, "taken up", options_.order,
+                    std::to_string(resume_.placed.size()) + " parts in place and " +
+                        std::to_string(resume_.delivered.size()) + " at the dock of " + resume_.station);
+    return true;
   }
 
   // Gives the last samples time to reach the readers before the participant goes.
@@ -179,6 +210,7 @@ class TwinProcess {
     fb::Resource r("twin-" + options_.order, 4096);
     twin::OrderSettings settings;
     settings.order_id = options_.order;
+    settings.resume = resume_;
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
     fb::NegotiationSettings negotiation;
     negotiation.wait = settings.wait_timeout;
@@ -252,6 +284,10 @@ class TwinProcess {
       std::cout << "finding: " << fb::get<std::string>(d, "message") << std::endl;  // also when quiet
     }));
     r.connect("orchestrator", "FINDING", "findings", "REQ");
+    r.add(std::make_unique<fb::ActionBlock>("placed", [this](const fb::Data& d) {
+      if (store_) store_->place(options_.order, fb::get<std::string>(d, "part"));
+    }));
+    r.connect("orchestrator", "PLACED", "placed", "REQ");
     bool finished = false;
     r.add(std::make_unique<fb::ActionBlock>("finished", [&finished](const fb::Data&) { finished = true; }));
     r.connect("orchestrator", "FINISHED", "finished", "REQ");
@@ -295,6 +331,7 @@ class TwinProcess {
   std::unique_ptr<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>> result_;
   std::vector<std::function<void()>> starters_;
   std::unique_ptr<state::CellStore> store_;  // the cell's durable state, if it keeps one
+  twin::OrderSettings::Resume resume_;
   std::string stored_state_;
 };
 
