@@ -284,7 +284,7 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     out.push_back(buffer);
   }
   for (auto& p : out) {
-    if (p.name != "cell-sim") p.argv.insert(p.argv.end(), {"--state-dir", c.state_folder().string()});
+    p.argv.insert(p.argv.end(), {"--state-dir", c.state_folder().string()});
     if (!c.localhost_only) p.argv.push_back("--all-interfaces");
   }
   return out;

@@ -321,14 +321,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
                                                       [](const cell::Release& r) { return dds::to_data(r); });
   // With the cell's state, an order whose twin died waits for the twin the cell starts again.
   fb::OrderWatch::Resumable resumable;
-  if (n.store) {
-    resumable = [&n](const std::string& order) {
-      for (const auto& o : n.store->orders()) {
-        if (o.order == order) return !o.ended() && !o.product.empty();  // the desk's, and not over
-      }
-      return false;
-    };
-  }
+  if (n.store) resumable = [&n](const std::string& order) { return n.store->awaits_twin(order); };
   auto& orders = dds::watch_orders(resource, participant, std::move(resumable));
   n.starters.push_back([&orders] { orders.start(); });
   resource.connect("calls", "IND", "contractor", "CFP");

@@ -420,6 +420,14 @@ std::vector<OrderRecord> CellStore::orders() const {
   return out;
 }
 
+bool CellStore::awaits_twin(const std::string& order) const {
+  Statement row(db_, "SELECT state, product FROM orders WHERE order_id = ?");
+  row.bind(order);
+  if (!row.step()) return false;
+  const std::string state = row.text(0);
+  return state != "DONE" && state != "FAILED" && !row.text(1).empty();
+}
+
 bool OrderRecord::ended() const { return state == "DONE" || state == "FAILED"; }
 
 void CellStore::journal(const std::string& source, const std::string& event, const std::string& order,

@@ -133,6 +133,9 @@ class CellStore {
   // One more twin started for the order; the attempts so far.
   int count_attempt(const std::string& order);
   std::vector<OrderRecord> orders() const;
+  // An order of the cell's desk that has not ended: when its twin dies, the cell starts
+  // another, so what the order booked and built waits for it.
+  bool awaits_twin(const std::string& order) const;
 
   void journal(const std::string& source, const std::string& event, const std::string& order = "",
                const std::string& detail = "");

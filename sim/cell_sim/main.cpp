@@ -19,6 +19,7 @@
 #include "negotiationPubSubTypes.h"
 #include "simulationPubSubTypes.h"
 #include "services/node/run.hpp"
+#include "services/state/cell_store.hpp"
 
 namespace {
 // Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
   dds::add_bounds_option(app, bounds);
   app.add_option("--real-time-factor", factor, "Sim seconds per wall second")->check(CLI::PositiveNumber);
   app.add_flag("--verbose", verbose, "Print every request and reply");
+  std::string state_dir;
+  dds::add_state_option(app, state_dir);
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(settings, all_interfaces);
   std::signal(SIGINT, stop);
@@ -73,7 +76,12 @@ int main(int argc, char** argv) {
           return fb::Data{{"resource_id", r.resource_id().to_string()}, {"order_id", r.order_id().to_string()}};
         }));
     resource.connect("hires", "IND", "world", "HIRED");
-    auto& orders = dds::watch_orders(resource, participant);
+    // With the cell's state, the bodies of an order whose twin died wait for the next twin.
+    std::unique_ptr<state::CellStore> store;
+    if (!state_dir.empty()) store = std::make_unique<state::CellStore>(state_dir);
+    fb::OrderWatch::Resumable resumable;
+    if (store) resumable = [&store](const std::string& order) { return store->awaits_twin(order); };
+    auto& orders = dds::watch_orders(resource, participant, std::move(resumable));
     resource.connect("order_watch", "ENDED", "world", "ORDER_ENDED");
     resource.connect("requests", "IND", "world", "REQUEST");
     resource.connect("world", "REPLY", "replies", "REQ");
@@ -94,8 +102,13 @@ int main(int argc, char** argv) {
     hires.start();
     orders.start();
     std::cout << "cell-sim ready on domain " << settings.domain_id << ", real-time factor " << factor << std::endl;
+    auto last_check = std::chrono::steady_clock::now();
     while (running) {
       if (!resource.wait_and_run_one(std::chrono::milliseconds(1))) resource.post("world", "TICK");
+      if (store && std::chrono::steady_clock::now() - last_check > std::chrono::seconds(1)) {
+        last_check = std::chrono::steady_clock::now();
+        resource.post("order_watch", "CHECK");
+      }
     }
   } catch (const std::exception& e) {
     std::cerr << "error: cell-sim: " << e.what() << '\n';

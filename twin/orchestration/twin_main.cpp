@@ -83,10 +83,8 @@ class TwinProcess {
     if (store_ && state != stored_state_) {
       // The product is done: its parts on the station are counted as assembled from now on.
       if (state == "DONE") store_->assemble(options_.order);
-      // A twin told to stop (the cell goes down) leaves its order to be taken up again.
-      const std::string stored = state == "FAILED" && !running ? "INTERRUPTED" : state;
-      store_->set_order(options_.order, stored, state == "FAILED" ? message : "");
-      store_->journal("twin-" + options_.order, stored, options_.order, message);
+      store_->set_order(options_.order, state, state == "FAILED" ? message : "");
+      store_->journal("twin-" + options_.order, state, options_.order, message);
       stored_state_ = state;
     }
     if (!options_.quiet) std::cout << "[" << options_.order << "] " << state << ": " << message << std::endl;
@@ -132,8 +130,16 @@ class TwinProcess {
  private:
   // `reported`: the orchestrator has published FAILED already.
   int end_with(int code, const std::string& error, const std::string& plan_file = "", bool reported = false) {
+    if (store_ && !running) {
+      // The cell stops the twin (it goes down): the order is paused, not over. No final
+      // status: the resources keep what it booked for the twin that takes it up.
+      store_->set_order(options_.order, "INTERRUPTED", error);
+      store_->journal("twin-" + options_.order, "INTERRUPTED", options_.order, error);
+      std::cerr << "order " << options_.order << " paused: " << error << '\n';
+      return code;
+    }
     if (!reported) status("FAILED", error, 0);
-    if (store_ && running) store_->set_order(options_.order, "FAILED", error, code);
+    if (store_) store_->set_order(options_.order, "FAILED", error, code);
     result(false, plan_file, "", error);
     std::cerr << "error: order " << options_.order << ": " << error << '\n';
     linger();
