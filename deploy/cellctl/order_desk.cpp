@@ -36,7 +36,8 @@ void OrderDesk::tend() {
     if (const auto wait = not_before_.find(id); wait != not_before_.end() && now < wait->second) continue;
     const int attempt = store_.count_attempt(id);
     if (attempt > max_attempts_) {
-      const std::string why = "its twin ended " + std::to_string(attempt - 1) + " times before the order did";
+      const std::string why = "its twin ended " + std::to_string(attempt - 1) + " times before the order did" +
+                              (o.reason.empty() ? "" : "; last: " + o.reason);
       store_.set_order(id, "FAILED", why, 1);
       store_.journal("cellctl", "FAILED", id, why);
       log_("order " + id + " failed: " + why);

@@ -21,7 +21,7 @@ namespace cellctl {
 class OrderDesk {
  public:
   OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
-            int max_attempts = 3);
+            int max_attempts = 5);
   ~OrderDesk();
 
   // Starts twins for the orders that have none, notes the twins that ended. Call often.

@@ -11,6 +11,7 @@
 #include "services/dds/conversions.hpp"
 #include "services/dds/order_watch.hpp"
 #include "services/dds/service_blocks.hpp"
+#include "services/node/restart_reason.hpp"
 #include "services/node/sim_requests.hpp"
 #include "services/state/cell_store.hpp"
 #include "simulationPubSubTypes.h"
@@ -171,8 +172,7 @@ struct ResourceNode::Impl {
     overflow_answers->wait_for_settled_readers(std::chrono::milliseconds(500), std::chrono::seconds(3));
     for (const auto& c : interrupted) {
       const bool concerned = !c.part.empty() && recovered.find(c.part) != std::string::npos;
-      const std::string reason = config.id + " restarted: its process ended with this command under way or queued" +
-                                 (concerned ? "; " + recovered : "");
+      const std::string reason = fb::restarted_reason(config.id) + (concerned ? "; " + recovered : "");
       store->journal(config.id, "aborted", c.order, c.command_id + ": " + reason);
       cell::CommandEvent e;
       e.command_id(c.command_id);

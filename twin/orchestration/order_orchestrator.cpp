@@ -1,5 +1,7 @@
 #include "twin/orchestration/order_orchestrator.hpp"
 
+#include "services/node/restart_reason.hpp"
+
 #include <algorithm>
 
 #include "services/blocks/sample_checks.hpp"
@@ -44,7 +46,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
   declare_output("PLACED", {"part"});
-  declare_output("FINISHED", {"complete", "error"});
+  declare_output("FINISHED", {"complete", "error", "take_up"});
 
   const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
                               "HIRING", "PHYSICAL",     "CLEANUP", "ENDED"};
@@ -621,6 +623,11 @@ void OrderOrchestrator::resend_unheard() {
 void OrderOrchestrator::fail(const std::string& reason) {
   if (!error_.empty()) return;
   error_ = reason;
+  if (settings_.take_up_after_restart && state() == "PHYSICAL" && fb::says_restarted(reason)) {
+    take_up_ = true;
+    enter("ENDED");
+    return emit("FINISHED", {{"complete", false}, {"error", error_}, {"take_up", true}});
+  }
   // The mobile robot need not fetch what will not be assembled.
   for (const auto& [fetch, part] : fetch_of_) {
     if (!delivered_.count(fetch)) emit("CANCEL", {{"command_id", fetch}});
@@ -638,7 +645,7 @@ void OrderOrchestrator::finish() {
   } else {
     status("FAILED", error_, 0);
   }
-  emit("FINISHED", {{"complete", error_.empty()}, {"error", error_}});
+  emit("FINISHED", {{"complete", error_.empty()}, {"error", error_}, {"take_up", false}});
 }
 
 void OrderOrchestrator::status(const std::string& state, const std::string& message, double progress) {

@@ -39,7 +39,7 @@
 //   outputs: CALL (to the Negotiator), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: its body, assembled in place),
-//            FINISHED (complete, error)
+//            FINISHED (complete, error, take_up: ended for the next twin to take the order up)
 
 #include <chrono>
 #include <deque>
@@ -76,6 +76,10 @@ struct OrderSettings {
     std::set<std::string> delivered;  // bodies at the station's dock, not assembled yet
     std::set<std::string> used;       // every body handed out before: a part set aside needs a new one
   } resume;
+  // A resource it hired restarted under its work (services/node/restart_reason.hpp): end
+  // this twin at once, releasing nothing, so that the next twin the cell starts takes the
+  // order up from the cell's state. Off: the order fails.
+  bool take_up_after_restart = false;
 };
 
 class OrderOrchestrator : public fb::BasicBlock {
@@ -86,6 +90,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   // back), each step done so far with the trajectory cell-sim validated.
   const Plan& plan() const { return plan_; }
   const std::string& error() const { return error_; }
+  bool take_up() const { return take_up_; }
   // Arm time of physical assembly: how long the order will hold a station, s of sim time.
   double physical_estimate() const;
 
@@ -170,6 +175,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::map<std::string, Sent> unheard_;  // commands sent that no event has answered yet
   std::map<std::string, PartIndex> fetch_of_;
   std::string error_;
+  bool take_up_ = false;
 };
 
 }  // namespace twin

@@ -217,6 +217,7 @@ class TwinProcess {
     twin::OrderSettings settings;
     settings.order_id = options_.order;
     settings.resume = resume_;
+    settings.take_up_after_restart = store_ && store_->awaits_twin(options_.order);
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
     fb::NegotiationSettings negotiation;
     negotiation.wait = settings.wait_timeout;
@@ -315,6 +316,13 @@ class TwinProcess {
       }
     }
     if (!finished) return end_with(1, "stopped before the order ended");
+    if (orchestrator.take_up()) {
+      // Nothing released, no final status: the cell's next twin takes the order up.
+      store_->set_order(options_.order, "INTERRUPTED", orchestrator.error());
+      store_->journal("twin-" + options_.order, "to be taken up", options_.order, orchestrator.error());
+      std::cerr << "order " << options_.order << ": " << orchestrator.error() << "; the next twin takes it up\n";
+      return 3;
+    }
 
     // What the designer gets: the plan as virtual assembly validated it (replanned if cell-sim
     // made it go back), planning's and virtual assembly's findings, and the animation.
