@@ -93,7 +93,11 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   }, arrived);
   // A delivery that failed on the way: the part goes back to its buffer.
   transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, fail](const Data& reply) {
-    if (store()) store()->return_carried(resource_id());
+    if (store()) {
+      for (const auto& p : store()->return_carried(resource_id())) {
+        store()->journal(resource_id(), "returned", p.order, p.part + " (" + p.part_type + ") back to " + p.buffer);
+      }
+    }
     fail(reply);
   }, answered);
 }

@@ -1,6 +1,5 @@
 #include "services/state/cell_store.hpp"
 
-#include <algorithm>
 #include <chrono>
 
 namespace state {
@@ -243,19 +242,22 @@ void CellStore::assemble(const std::string& order) {
   t.commit();
 }
 
+std::vector<PartRecord> CellStore::parts_held(const std::string& holder, Place place) const {
+  Statement rows(db_, "SELECT order_id, part, part_type, buffer, station FROM parts WHERE holder = ? AND place = ? "
+                      "ORDER BY order_id, part");
+  rows.bind(holder, place_name(place));
+  std::vector<PartRecord> out;
+  while (rows.step()) out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), holder, place, rows.text(4)});
+  return out;
+}
+
 std::vector<PartRecord> CellStore::return_carried(const std::string& carrier) {
   Transaction t(*this);
-  std::vector<PartRecord> carried = parts();
-  carried.erase(std::remove_if(carried.begin(), carried.end(),
-                               [&](const PartRecord& p) { return p.place != Place::in_transit || p.holder != carrier; }),
-                carried.end());
+  const std::vector<PartRecord> carried = parts_held(carrier, Place::in_transit);
   for (const auto& p : carried) {
     Statement(db_, "UPDATE stock SET count = count + 1 WHERE buffer = ? AND part_type = ?").bind(p.buffer, p.part_type).step();
     Statement(db_, "UPDATE parts SET place = 'returned', holder = '' WHERE order_id = ? AND part = ?")
         .bind(p.order, p.part)
-        .step();
-    Statement(db_, "INSERT INTO journal(time, source, event, order_id, detail) VALUES(?, ?, 'returned', ?, ?)")
-        .bind(unix_now(), carrier, p.order, p.part + " (" + p.part_type + ") back to " + p.buffer)
         .step();
   }
   t.commit();
@@ -264,15 +266,9 @@ std::vector<PartRecord> CellStore::return_carried(const std::string& carrier) {
 
 std::vector<PartRecord> CellStore::hold_for_inspection(const std::string& holder) {
   Transaction t(*this);
-  std::vector<PartRecord> held = parts();
-  held.erase(std::remove_if(held.begin(), held.end(),
-                            [&](const PartRecord& p) { return p.place != Place::in_gripper || p.holder != holder; }),
-             held.end());
+  const std::vector<PartRecord> held = parts_held(holder, Place::in_gripper);
   for (const auto& p : held) {
     Statement(db_, "UPDATE parts SET place = 'inspection' WHERE order_id = ? AND part = ?").bind(p.order, p.part).step();
-    Statement(db_, "INSERT INTO journal(time, source, event, order_id, detail) VALUES(?, ?, 'inspection', ?, ?)")
-        .bind(unix_now(), holder, p.order, p.part + " (" + p.part_type + ") was in " + holder + "'s gripper")
-        .step();
   }
   t.commit();
   return held;

@@ -105,7 +105,7 @@ class CellStore {
   void assemble(const std::string& order);
   // A carrier (a robot) that restarted gives what it carried back to the buffers it came
   // from; an arm that restarted leaves what it gripped for inspection. Each returns the
-  // parts it moved, as they were.
+  // parts it moved, as they were (the caller journals them).
   std::vector<PartRecord> return_carried(const std::string& carrier);
   std::vector<PartRecord> hold_for_inspection(const std::string& holder);
 
@@ -149,6 +149,7 @@ class CellStore {
   class Statement;
   class Transaction;
   void exec(const char* sql) const;
+  std::vector<PartRecord> parts_held(const std::string& holder, Place place) const;
   void move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
                  const char* from);
   sqlite3* db_ = nullptr;

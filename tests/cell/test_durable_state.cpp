@@ -18,14 +18,6 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using nlohmann::json;
 
-bool appears(const fs::path& file, const std::string& text, std::chrono::seconds timeout = 30s) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (test::read_text(file).find(text) != std::string::npos) return true;
-    std::this_thread::sleep_for(50ms);
-  }
-  return false;
-}
 
 json status_json(const std::string& domain, const fs::path& dir) {
   const fs::path out = dir / "status.json";
@@ -57,8 +49,8 @@ void kill_and_wait_restart(pid_t up, const std::string& argument, const fs::path
   const pid_t pid = test::child_with_argument(up, argument);
   REQUIRE(pid > 0);
   ::kill(pid, SIGKILL);
-  REQUIRE(appears(log, argument + " restarted (pid"));
-  REQUIRE(appears(log, "restart " + std::to_string(restart) + ")"));
+  REQUIRE(test::appears(log, argument + " restarted (pid"));
+  REQUIRE(test::appears(log, "restart " + std::to_string(restart) + ")"));
 }
 
 }  // namespace
@@ -72,7 +64,7 @@ TEST_CASE("kills mid-order: the order is taken up, every part accounted for, sto
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "20", "--state-dir",
                          state_dir.string()},
                         log.string());
-  REQUIRE(appears(log, "cell up on domain"));
+  REQUIRE(test::appears(log, "cell up on domain"));
 
   // An order under way when its mobile robot dies.
   test::ChildProcess first({CELLCTL_EXE, "submit", lego, "--domain", domain, "--order", "first", "--out",
@@ -176,7 +168,7 @@ TEST_CASE("a twin killed during physical assembly is started again and finishes 
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir",
                          state_dir.string()},
                         log.string());
-  REQUIRE(appears(log, "cell up on domain"));
+  REQUIRE(test::appears(log, "cell up on domain"));
   test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
                              domain, "--order", "tower", "--out", (dir / "tower").string()},
                             (dir / "submit.log").string());
@@ -204,7 +196,7 @@ TEST_CASE("cellctl down pauses the orders under way, and up on the same state ta
   const std::vector<std::string> up_args{CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10",
                                          "--state-dir", state_dir.string()};
   auto up = std::make_unique<test::ChildProcess>(up_args, (dir / "up-1.log").string());
-  REQUIRE(appears(dir / "up-1.log", "cell up on domain"));
+  REQUIRE(test::appears(dir / "up-1.log", "cell up on domain"));
   test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
                              domain, "--order", "paused", "--out", (dir / "paused").string()},
                             (dir / "submit.log").string());

@@ -12,15 +12,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-// Waits until the text shows up in the file.
-bool appears(const fs::path& file, const std::string& text, std::chrono::seconds timeout = 30s) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (test::read_text(file).find(text) != std::string::npos) return true;
-    std::this_thread::sleep_for(50ms);
-  }
-  return false;
-}
 
 }  // namespace
 
@@ -33,14 +24,14 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
   const fs::path log = dir / "up.log";
   test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain, "--state-dir", (dir / "state").string()},
                         log.string());
-  REQUIRE(appears(log, "cell up on domain"));
+  REQUIRE(test::appears(log, "cell up on domain"));
 
   // buffer-2 (the Lego bricks) dies hard: it is back, and a Lego order is assembled.
   const pid_t first = test::child_with_argument(up.pid(), "buffer-2");
   REQUIRE(first > 0);
   ::kill(first, SIGKILL);
-  REQUIRE(appears(log, "buffer-2 ended (exit 137); restarting it in 500 ms"));
-  REQUIRE(appears(log, "buffer-2 restarted"));
+  REQUIRE(test::appears(log, "buffer-2 ended (exit 137); restarting it in 500 ms"));
+  REQUIRE(test::appears(log, "buffer-2 restarted"));
   const int order = test::cellctl({"submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
                                    domain, "--order", "after-restart", "--out", (dir / "after-restart").string()},
                                   dir / "order.log");
@@ -56,7 +47,7 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
     }
     REQUIRE(pid > 0);
     ::kill(pid, SIGKILL);
-    if (kill == 2) REQUIRE(appears(log, "restart 2)"));
+    if (kill == 2) REQUIRE(test::appears(log, "restart 2)"));
   }
   CHECK(up.wait_for_exit(30s) == 1);
   CHECK(test::read_text(log).find("error: buffer-2 ended 3 times within 60 s, last with exit 137; stopping the cell") !=
@@ -71,7 +62,7 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
   const fs::path log = dir / "up.log";
   auto up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain, "--state-dir", (dir / "state").string()},
                                                  log.string());
-  REQUIRE(appears(log, "cell up on domain"));
+  REQUIRE(test::appears(log, "cell up on domain"));
   CHECK(test::cellctl({"up", "--domain", domain}, dir / "second.log", 30s) == 1);
   CHECK(test::read_text(dir / "second.log").find("a cell runs on domain 221 already") != std::string::npos);
 
@@ -96,7 +87,7 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
   CHECK(test::read_text(dir / "down.log").find("its cellctl up was killed") != std::string::npos);
   up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain, "--state-dir", (dir / "state").string()},
                                             (dir / "again.log").string());
-  REQUIRE(appears(dir / "again.log", "cell up on domain"));
+  REQUIRE(test::appears(dir / "again.log", "cell up on domain"));
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down2.log", 30s) == 0);
   CHECK(up->wait_for_exit(20s) == 0);
 }

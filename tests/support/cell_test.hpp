@@ -38,6 +38,17 @@ inline int cellctl(std::vector<std::string> args, const std::filesystem::path& l
   return p.wait_for_exit(timeout);
 }
 
+// Waits until the text shows up in the file (a process's log).
+inline bool appears(const std::filesystem::path& file, const std::string& text,
+                    std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (read_text(file).find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
 // Whether the process runs: it exists and is not a zombie (an orphan that ended waits to be
 // reaped by whoever adopted it).
 inline bool is_running(pid_t pid) {

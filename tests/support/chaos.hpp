@@ -112,10 +112,7 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
                                                                       "--real-time-factor", o.real_time_factor,
                                                                       "--state-dir", state_dir.string()},
                                              log.string());
-    const auto deadline = Clock::now() + 60s;
-    while (read_text(log).find("cell up on domain") == std::string::npos && Clock::now() < deadline) {
-      std::this_thread::sleep_for(50ms);
-    }
+    appears(log, "cell up on domain", 60s);
     return up;
   };
   clean_stale_dds_segments();
@@ -200,7 +197,7 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
         const pid_t old = up->pid();
         const auto children = children_of(old);
         r.kills.push_back("t=" + std::to_string(seconds()) + " cellctl up (pid " + std::to_string(old) + ")");
-        pending.push_back({Clock::now(), "cellctl up", old, true});
+        pending.push_back({Clock::now(), "cellctl up", old, true, false, ""});
         up->kill_hard();
         // Its processes end with it (they asked for SIGTERM when their parent goes): the
         // operator starts it again once they are gone.
@@ -215,7 +212,7 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
         const std::string identity = chaos_detail::identity_of(pid, name);
         ::kill(pid, SIGKILL);
         r.kills.push_back("t=" + std::to_string(seconds()) + " " + identity + " (pid " + std::to_string(pid) + ")");
-        pending.push_back({Clock::now(), identity, pid, false});
+        pending.push_back({Clock::now(), identity, pid, false, false, ""});
       }
       o.log(r.kills.back());
     }
