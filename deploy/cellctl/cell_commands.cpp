@@ -241,7 +241,8 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
 }
 
 // Hands the order to the desk of the cell `cellctl up` runs (its database), and follows it to
-// its end: the twin's exit code (0 assembled, 1 failed, 2 a bad product description).
+// its end: the twin's exit code (0 assembled, 1 failed, 2 a bad product description; 3 when no
+// cell has run on the domain for a minute: the order waits in the state for the next up).
 int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& order, CellObserver& observer) {
   state::CellStore store(cell.state_folder());
   const std::string product = fs::absolute(order.product).string(), out = fs::absolute(order.out).string();
@@ -258,7 +259,16 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
   observer.on_status([id = order.id](const cell::OrderStatus& s) {
     if (s.order_id().to_string() == id) print_progress(s);
   });
+  auto cell_seen = std::chrono::steady_clock::now();
   for (;;) {
+    if (!running_state_dir(cell.domain).empty()) cell_seen = std::chrono::steady_clock::now();
+    if (std::chrono::steady_clock::now() - cell_seen > 60s) {  // a paused cell that does not come back
+      observer.on_status({});
+      std::cerr << "error: no cell has run on domain " << cell.domain << " for 60 s; order " << order.id
+                << " waits in the cell's state (" << cell.state_folder().string()
+                << "), and the next `cellctl up` on it takes the order up\n";
+      return 3;
+    }
     for (const auto& known : store.orders()) {
       if (known.order != order.id || !known.ended() || known.exit_code < 0) continue;
       observer.on_status({});
