@@ -215,7 +215,9 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
     if (ids.count(s.order_id().to_string())) print_progress(s);
   });
   for (auto& order : orders) {
-    const auto argv = twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence, o.path, wait_s);
+    // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
+    const auto argv = twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence, o.path,
+                                cell.state_dir, wait_s);
     order.sim_start = observer.sim_now();
     order.twin = std::make_unique<Process>("twin-" + order.id, argv);
   }
@@ -338,8 +340,14 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
                             store.journal(process, event, "", what);
                             world_lost |= event == "restarting all";
                           });
-    wait_for_cell(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
+    // Before the cell is up: a submit that sees the cell's resources finds its state too.
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n' << fs::absolute(cell.state_folder()).string() << '\n';
+    try {
+      wait_for_cell(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
+    } catch (...) {
+      fs::remove(pid_file(cell.domain));
+      throw;
+    }
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
               << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"
               << std::endl;

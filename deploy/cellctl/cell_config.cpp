@@ -236,11 +236,11 @@ std::filesystem::path CellConfig::state_folder() const {
 
 std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::path& bin, const std::string& order,
                                    const std::string& product, const std::string& out, const std::string& sequence,
-                                   const std::string& path, double wait_s) {
+                                   const std::string& path, const std::filesystem::path& state_dir, double wait_s) {
   std::vector<std::string> argv{(bin / "twin").string(), "--domain", std::to_string(c.domain), "--order", order,
                                 "--product", product, "--out", out, "--sequence", sequence, "--path", path, "--wait",
-                                std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--state-dir",
-                                c.state_folder().string(), "--quiet"};
+                                std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--quiet"};
+  if (!state_dir.empty()) argv.insert(argv.end(), {"--state-dir", state_dir.string()});
   if (!c.localhost_only) argv.push_back("--all-interfaces");
   return argv;
 }

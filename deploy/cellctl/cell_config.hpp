@@ -80,9 +80,10 @@ struct ProcessSpec {
 // cell-sim first (the others wait for it), then the station, the robot, the buffers.
 std::vector<ProcessSpec> cell_processes(const CellConfig& cell, const std::filesystem::path& bin_dir);
 
-// The twin of one order on the cell (quiet: whoever started it shows its status).
+// The twin of one order on the cell (quiet: whoever started it shows its status); an empty
+// `state_dir`: the twin keeps no durable state (a cell of processes started by hand).
 std::vector<std::string> twin_argv(const CellConfig& cell, const std::filesystem::path& bin_dir, const std::string& order,
                                    const std::string& product, const std::string& out, const std::string& sequence,
-                                   const std::string& path, double wait_s = 30);
+                                   const std::string& path, const std::filesystem::path& state_dir, double wait_s = 30);
 
 }  // namespace cellctl

@@ -44,7 +44,8 @@ void OrderDesk::tend() {
       continue;
     }
     try {
-      twins_[id] = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path));
+      twins_[id] = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
+                                                                      cell_.state_folder()));
       store_.journal("cellctl", "twin started", id, "attempt " + std::to_string(attempt));
       if (attempt > 1) log_("order " + id + ": twin started again (attempt " + std::to_string(attempt) + ")");
     } catch (const std::exception& e) {
