@@ -9,8 +9,11 @@ BufferBlock::BufferBlock(std::string name, std::string resource_id, std::map<std
   declare_input("AWARDED", {"order_id", "part_type", "count"});
   declare_output("CAPABILITY");
   transition("READY", "AWARDED", "READY", [this](const Data& d) {
-    kept_[get<std::string>(d, "order_id")][get<std::string>(d, "part_type")] +=
-        static_cast<int>(get_or<std::int64_t>(d, "count", 1));
+    const std::string& order = get<std::string>(d, "order_id");
+    const std::string& type = get<std::string>(d, "part_type");
+    const int count = static_cast<int>(get_or<std::int64_t>(d, "count", 1));
+    if (store()) store()->keep(this->resource_id(), order, type, count);
+    kept_[order][type] += count;
   });
   transition("READY", "START", "READY", [this](const Data& d) {
     // A command names the type it wants; older senders put it in "part".
@@ -49,17 +52,29 @@ int BufferBlock::free(const std::string& part_type) const {
 }
 
 void BufferBlock::check(const Data& command, SampleCheck& c) const {
-  if (get<std::string>(command, "operation") == "give" && get_or<std::string>(command, "part", "").empty()) {
-    c.text("part_type", true);
-  }
+  if (get<std::string>(command, "operation") != "give") return;
+  if (get_or<std::string>(command, "part", "").empty()) c.text("part_type", true);
+  // The durable state records who took the part: a robot that restarts gives back what its
+  // record says it carried. (That the sender is that robot is DDS-Security's to prove.)
+  c.text("destination", true);
 }
 
 std::string BufferBlock::recover() {
   const std::map<std::string, int> before = stock_;
   stock_ = store()->open_buffer(resource_id(), stock_);
-  return stock_ == before ? "" : "stock as stored, not as the deployment file gives it";
+  // What it kept for orders that ended while it was down goes back to the free stock.
+  kept_ = store()->kept(resource_id());
+  for (const auto& o : store()->orders()) {
+    if (o.ended() && kept_.erase(o.order)) store()->unkeep(resource_id(), o.order);
+  }
+  std::string changed = stock_ == before ? "" : "stock as stored, not as the deployment file gives it";
+  if (!kept_.empty()) changed += std::string(changed.empty() ? "" : "; ") + std::to_string(kept_.size()) + " orders' parts kept";
+  return changed;
 }
 
-void BufferBlock::order_ended(const std::string& order) { kept_.erase(order); }
+void BufferBlock::order_ended(const std::string& order) {
+  kept_.erase(order);
+  if (store()) store()->unkeep(resource_id(), order);
+}
 
 }  // namespace fb

@@ -10,6 +10,9 @@ CREATE TABLE IF NOT EXISTS stock(
   buffer TEXT NOT NULL, part_type TEXT NOT NULL,
   initial INTEGER NOT NULL, count INTEGER NOT NULL CHECK(count >= 0),
   PRIMARY KEY(buffer, part_type));
+CREATE TABLE IF NOT EXISTS kept(
+  buffer TEXT NOT NULL, order_id TEXT NOT NULL, part_type TEXT NOT NULL, count INTEGER NOT NULL CHECK(count >= 0),
+  PRIMARY KEY(buffer, order_id, part_type));
 CREATE TABLE IF NOT EXISTS parts(
   order_id TEXT NOT NULL, part TEXT NOT NULL, part_type TEXT NOT NULL, buffer TEXT NOT NULL,
   place TEXT NOT NULL CHECK(place IN ('in_transit','on_station','in_gripper','placed','assembled','inspection',
@@ -188,7 +191,33 @@ void CellStore::give(const std::string& buffer, const std::string& type, const s
                 "place = 'in_transit', holder = excluded.holder, station = '' WHERE place = 'returned'");
   put.bind(order, part, type, buffer, carrier).step();
   if (sqlite3_changes(db_) != 1) throw StoreError("part " + part + " of order " + order + " was handed out already");
+  Statement(db_, "UPDATE kept SET count = count - 1 WHERE buffer = ? AND order_id = ? AND part_type = ? AND count > 0")
+      .bind(buffer, order, type)
+      .step();
   t.commit();
+}
+
+void CellStore::keep(const std::string& buffer, const std::string& order, const std::string& type, int count) {
+  Transaction t(*this);
+  Statement(db_, "INSERT INTO kept(buffer, order_id, part_type, count) VALUES(?, ?, ?, ?) "
+                 "ON CONFLICT(buffer, order_id, part_type) DO UPDATE SET count = count + excluded.count")
+      .bind(buffer, order, type, count)
+      .step();
+  t.commit();
+}
+
+void CellStore::unkeep(const std::string& buffer, const std::string& order) {
+  Transaction t(*this);
+  Statement(db_, "DELETE FROM kept WHERE buffer = ? AND order_id = ?").bind(buffer, order).step();
+  t.commit();
+}
+
+std::map<std::string, std::map<std::string, int>> CellStore::kept(const std::string& buffer) const {
+  Statement rows(db_, "SELECT order_id, part_type, count FROM kept WHERE buffer = ? AND count > 0");
+  rows.bind(buffer);
+  std::map<std::string, std::map<std::string, int>> out;
+  while (rows.step()) out[rows.text(0)][rows.text(1)] = static_cast<int>(rows.integer(2));
+  return out;
 }
 
 void CellStore::move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,

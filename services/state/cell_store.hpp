@@ -94,6 +94,11 @@ class CellStore {
   // Throws StoreError when the buffer has none.
   void give(const std::string& buffer, const std::string& type, const std::string& order, const std::string& part,
             const std::string& carrier);
+  // Parts a buffer keeps for an order that won its award (counted down as they are given,
+  // dropped when the order ends): order -> type -> count.
+  void keep(const std::string& buffer, const std::string& order, const std::string& type, int count);
+  void unkeep(const std::string& buffer, const std::string& order);
+  std::map<std::string, std::map<std::string, int>> kept(const std::string& buffer) const;
   // The part reached `station` (a robot put it down at its dock).
   void deliver(const std::string& order, const std::string& part, const std::string& station);
   void grip(const std::string& order, const std::string& part, const std::string& arm);

@@ -61,7 +61,8 @@ std::unique_ptr<CapabilityReader> watch_capabilities(const dds::ParticipantPtr& 
       [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id().to_string()); }); }, qos);
 }
 
-cell::Command give(const std::string& id, const std::string& part, const std::string& award) {
+cell::Command give(const std::string& id, const std::string& part, const std::string& award,
+                   const std::string& taker = "robot-1") {
   cell::Command c;
   c.command_id(id);
   c.resource_id("buffer-1");
@@ -69,6 +70,7 @@ cell::Command give(const std::string& id, const std::string& part, const std::st
   c.award(award);
   c.operation("give");
   c.part(part);
+  c.destination(taker);
   return c;
 }
 
@@ -96,6 +98,15 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   const std::string award = test::hire(participant, "buffer-1", "o1", "give", {"", "SquarePeg", 1}, &why);
   INFO(why);
   REQUIRE(award == "o1/give/buffer-1");
+
+  // Whoever takes a part is on its record (a robot that restarts gives back what it carried):
+  // a give that names nobody is refused, and the part stays.
+  REQUIRE(commands.write(give("c0", "SquarePeg", award, "")));
+  REQUIRE(seen.wait([&] { return !seen.events.empty(); }));
+  CHECK(seen.events[0].command_id() == "c0");
+  CHECK(seen.events[0].state() == cell::REJECTED);
+  CHECK(seen.events[0].reason() == "destination: empty");
+  seen.add([&] { seen.events.clear(); });
 
   REQUIRE(commands.write(give("c1", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 2; }));

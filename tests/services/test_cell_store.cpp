@@ -46,6 +46,26 @@ TEST_CASE("a buffer's stock is seeded once, and from then on the stored counts a
   CHECK(again.integrity() == "ok");
 }
 
+TEST_CASE("parts a buffer keeps for an order survive its restart, counted down as they are given", "[state]") {
+  const fs::path dir = fresh_dir("kept");
+  {
+    state::CellStore store(dir);
+    store.open_buffer("buffer-1", {{"Peg", 5}, {"Hole", 2}});
+    store.keep("buffer-1", "o1", "Peg", 2);
+    store.keep("buffer-1", "o1", "Peg", 1);  // a second award adds
+    store.keep("buffer-1", "o2", "Hole", 1);
+    store.give("buffer-1", "Peg", "o1", "o1/peg-1", "robot-1");
+  }
+  state::CellStore again(dir);
+  using Kept = std::map<std::string, std::map<std::string, int>>;
+  CHECK(again.kept("buffer-1") == Kept{{"o1", {{"Peg", 2}}}, {"o2", {{"Hole", 1}}}});
+  again.give("buffer-1", "Hole", "o2", "o2/hole-1", "robot-1");  // its last kept one: none left to show
+  CHECK(again.kept("buffer-1") == Kept{{"o1", {{"Peg", 2}}}});
+  again.unkeep("buffer-1", "o1");
+  CHECK(again.kept("buffer-1").empty());
+  CHECK(again.kept("buffer-2").empty());
+}
+
 TEST_CASE("a part moves buffer, robot, station, gripper, product, and is counted once at every step", "[state]") {
   state::CellStore store(fresh_dir("moves"));
   store.open_buffer("buffer-1", {{"Peg", 2}, {"Plate", 1}});
