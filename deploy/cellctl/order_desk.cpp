@@ -5,45 +5,60 @@
 namespace cellctl {
 
 OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
-                     int max_attempts)
-    : cell_(cell), store_(store), log_(std::move(log)), max_attempts_(max_attempts) {}
+                     int max_deaths)
+    : cell_(cell), store_(store), log_(std::move(log)), max_deaths_(max_deaths) {}
 
 OrderDesk::~OrderDesk() { interrupt_all(); }
 
 void OrderDesk::tend() {
   const auto now = std::chrono::steady_clock::now();
-  std::map<std::string, state::OrderRecord> orders;
-  for (auto& o : store_.orders()) orders[o.order] = o;
-
+  std::vector<std::pair<std::string, int>> ended;  // order, its twin's exit code
   for (auto it = twins_.begin(); it != twins_.end();) {
     const int code = it->second->poll();
     if (code < 0) {
       ++it;
       continue;
     }
-    const auto o = orders.find(it->first);
-    if (o != orders.end() && !o->second.ended()) {
-      log_("the twin of order " + it->first + " ended (exit " + std::to_string(code) +
-           ") before its order did; starting it again in 1 s");
-      store_.journal("twin-" + it->first, "ended", it->first, "exit " + std::to_string(code));
-      not_before_[it->first] = now + std::chrono::seconds(1);
-    }
+    ended.emplace_back(it->first, code);
     it = twins_.erase(it);
+  }
+  // Read after the twins ended: what each wrote last is in.
+  std::map<std::string, state::OrderRecord> orders;
+  for (auto& o : store_.orders()) orders[o.order] = o;
+
+  for (const auto& [id, code] : ended) {
+    const auto o = orders.find(id);
+    if (o == orders.end() || o->second.ended()) continue;
+    // A twin the cell stopped (it went down, cell-sim restarted, a resource restarted under
+    // its work) said INTERRUPTED: that is not the twin's failure. One that died says nothing.
+    const bool interrupted = o->second.state == "INTERRUPTED";
+    if (!interrupted) ++deaths_[id];
+    log_("the twin of order " + id + " ended (exit " + std::to_string(code) + (interrupted ? ", interrupted" : "") +
+         ") before its order did; starting it again in 1 s");
+    store_.journal("twin-" + id, "ended", id, "exit " + std::to_string(code));
+    not_before_[id] = now + std::chrono::seconds(1);
   }
 
   for (const auto& [id, o] : orders) {
     if (o.ended() || twins_.count(id) || o.product.empty()) continue;  // no product: not the desk's order
     if (const auto wait = not_before_.find(id); wait != not_before_.end() && now < wait->second) continue;
-    const int attempt = store_.count_attempt(id);
-    if (attempt > max_attempts_) {
-      const std::string why = "its twin ended " + std::to_string(attempt - 1) + " times before the order did" +
-                              (o.reason.empty() ? "" : "; last: " + o.reason);
+    std::string why;
+    if (deaths_[id] >= max_deaths_) {
+      why = "its twin died " + std::to_string(deaths_[id]) + " times before the order ended";
+    } else if (o.attempts >= kMaxAttemptsPerDeath * max_deaths_) {
+      why = "its twin was started " + std::to_string(o.attempts) + " times, and the cell stopped it every time";
+    }
+    if (!why.empty()) {
+      if (!o.reason.empty()) why += "; last: " + o.reason;
       store_.set_order(id, "FAILED", why, 1);
       store_.journal("cellctl", "FAILED", id, why);
       log_("order " + id + " failed: " + why);
       continue;
     }
     try {
+      const int attempt = store_.count_attempt(id);
+      // Until the twin says more: one killed before it wrote a word counts as died.
+      store_.set_order(id, "SUBMITTED", o.reason);
       twins_[id] = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
                                                                       cell_.state_folder()));
       store_.journal("cellctl", "twin started", id, "attempt " + std::to_string(attempt));

@@ -1,10 +1,12 @@
 #pragma once
 // The cell's order desk, run by `cellctl up`: orders are rows of the cell's database
 // (`cellctl submit` writes one), and the desk keeps a twin running for every order that has
-// not ended. A twin that dies before its order ended is started again after a second, and
-// the new twin takes the order up from the database (services/state); after `max_attempts`
-// twins the order fails with the reason. A twin the desk stops (the cell goes down) records
-// its order INTERRUPTED, and the next `cellctl up` on the same state takes it up again.
+// not ended. A twin that ends before its order did is started again after a second, and
+// the new twin takes the order up from the database (services/state). A twin the cell
+// stopped (it goes down, cell-sim restarts, a resource restarted under the twin's work)
+// records its order INTERRUPTED, and that costs the order nothing; a twin that died (killed,
+// crashed) counts, and after `max_deaths` of them the order fails with the reason. So does
+// one the cell stopped kMaxAttemptsPerDeath times as often: nothing loops for ever.
 
 #include <chrono>
 #include <functional>
@@ -21,7 +23,8 @@ namespace cellctl {
 class OrderDesk {
  public:
   OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
-            int max_attempts = 5);
+            int max_deaths = 5);
+  static constexpr int kMaxAttemptsPerDeath = 4;
   ~OrderDesk();
 
   // Starts twins for the orders that have none, notes the twins that ended. Call often.
@@ -34,7 +37,8 @@ class OrderDesk {
   const CellConfig& cell_;
   state::CellStore& store_;
   std::function<void(const std::string&)> log_;
-  int max_attempts_;
+  int max_deaths_;
+  std::map<std::string, int> deaths_;  // order -> its twins that died (since this desk started)
   std::map<std::string, std::unique_ptr<Process>> twins_;                   // order -> its twin
   std::map<std::string, std::chrono::steady_clock::time_point> not_before_;  // order -> next start
 };

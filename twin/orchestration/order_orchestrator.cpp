@@ -170,6 +170,13 @@ void OrderOrchestrator::try_begin_virtual() {
   status("VIRTUAL_ASSEMBLY", "virtual assembly in cell-sim", 0);
   step_ = candidate_ = 0;
   if (plan_.steps.empty()) return book();
+  if (settings_.resume.attempt > 1) {
+    // An earlier twin of the order may have died in the middle of it: its virtual bodies
+    // are still in the order's scene (cell-sim keeps them for the order), in the way.
+    std::vector<std::string> left{settings_.order_id + "/virtual/gripper-pad", settings_.order_id + "/virtual/gripper-carriage"};
+    for (PartIndex p = 0; p < product_.product.parts().size(); ++p) left.push_back(virtual_body(p));
+    for (const auto& body : left) actions_.push_back({Action::sim, sim_.remove(body), false, true});
+  }
   add_candidate(0, 0);
   next_action();
 }
@@ -444,6 +451,23 @@ void OrderOrchestrator::add_arm_moves(const std::string& body, const std::vector
   actions_.push_back({Action::command, command(arm_, "connect", body)});
 }
 
+namespace {
+
+// The body that stands for a step's part among `bodies`: its first one, or one a later twin
+// fetched anew ("<body>/rN").
+const std::string* body_in(const std::set<std::string>& bodies, const std::string& body) {
+  for (const std::string& b : bodies) {
+    if (b == body) return &b;
+    if (b.size() > body.size() + 2 && b.compare(0, body.size(), body) == 0 && b.compare(body.size(), 2, "/r") == 0 &&
+        std::all_of(b.begin() + body.size() + 2, b.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+      return &b;
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 void OrderOrchestrator::plan_physical() {
   const auto& resume = settings_.resume;
   status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ +
@@ -467,13 +491,15 @@ void OrderOrchestrator::plan_physical() {
     const Pose final_pose = at(station_, part.final_pose);
     std::string body = physical_body(step.part);
     const std::string mesh = part.mesh->file.string();
-    if (resume.placed.count(body)) {  // done: it stands in the product
+    if (const std::string* placed = body_in(resume.placed, body)) {  // done: it stands in the product
+      body = *placed;
       actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({final_pose}), {0, 0, 0}, true, mesh)});
       spawned_.insert(body);
       continue;
     }
     steps.push_back(i);
-    if (resume.delivered.count(body)) {  // at the dock, where a robot put it down
+    if (const std::string* delivered = body_in(resume.delivered, body)) {  // at the dock, where a robot put it down
+      body = *delivered;
       const Pose at_dock = with_translation(final_pose, dock[0], final_pose.translation().y(), dock[2]);
       actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at_dock}), {0, 0, 0}, false, mesh)});
       spawned_.insert(body);
@@ -482,7 +508,7 @@ void OrderOrchestrator::plan_physical() {
       bodies.push_back(body);
       continue;
     }
-    if (resume.used.count(body)) body += "/r" + std::to_string(resume.attempt);  // the first was set aside
+    if (body_in(resume.used, body)) body += "/r" + std::to_string(resume.attempt);  // the one before was set aside
     const std::string& buffer = buffer_of_.at(type);
     const Numbers& source = places_.at(buffer).dock;
     const Pose in_buffer = with_translation(final_pose, source[0], final_pose.translation().y(), source[2]);

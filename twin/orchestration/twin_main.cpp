@@ -154,7 +154,8 @@ class TwinProcess {
     for (const auto& o : store_->orders()) {
       if (o.order == options_.order) resume_.attempt = std::max(1, o.attempts);
     }
-    if (store_->parts(options_.order).empty()) return true;
+    // Even with no part handed out yet, a robot may still have the earlier twin's fetches.
+    if (store_->parts(options_.order).empty() && store_->commands_of(options_.order).empty()) return true;
     status("SUBMITTED", "taking the order up where its earlier twin left it", 0);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     const auto in_transit = [&] {
