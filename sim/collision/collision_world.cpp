@@ -5,6 +5,7 @@
 #include <map>
 
 #include <btBulletCollisionCommon.h>
+#include <BulletCollision/CollisionShapes/btTriangleShape.h>
 
 namespace sim {
 namespace {
@@ -29,16 +30,39 @@ btTransform to_bullet(const Pose& pose) {
 // --- MovingBody ---------------------------------------------------------------------------
 
 struct MovingBody::Impl {
-  btCompoundShape compound{true};
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  std::vector<std::string> member_of_child;  // compound child index -> member name
-  btCollisionObject object;
+  // `coarse`: every member convex (a one-piece mesh as its hull). `exact`: the same, but a
+  // one-piece mesh as its triangles, each a convex child; asked only where the coarse body
+  // penetrates, since the hull holds the mesh: where the hull does not reach, nothing does.
+  struct Shape {
+    btCompoundShape compound{true};
+    std::vector<std::unique_ptr<btCollisionShape>> shapes;
+    std::vector<std::string> member_of_child;  // compound child index -> member name
+    btCollisionObject object;
+    Shape() { object.setCollisionShape(&compound); }
+    void add(const std::string& member, std::unique_ptr<btCollisionShape> shape, const btTransform& offset) {
+      compound.addChildShape(offset, shape.get());
+      member_of_child.push_back(member);
+      shapes.push_back(std::move(shape));
+    }
+  };
+  Shape coarse, exact;
+  bool has_exact = false;
 
-  Impl() { object.setCollisionShape(&compound); }
   void add(const std::string& member, std::unique_ptr<btCollisionShape> shape, const Pose& offset) {
-    compound.addChildShape(to_bullet(offset), shape.get());
-    member_of_child.push_back(member);
-    shapes.push_back(std::move(shape));
+    exact.add(member, clone(*shape), to_bullet(offset));
+    coarse.add(member, std::move(shape), to_bullet(offset));
+  }
+  static std::unique_ptr<btCollisionShape> clone(const btCollisionShape& shape) {
+    if (shape.getShapeType() == BOX_SHAPE_PROXYTYPE) {
+      const auto& box = static_cast<const btBoxShape&>(shape);
+      auto copy = std::make_unique<btBoxShape>(box.getHalfExtentsWithoutMargin());
+      copy->setMargin(box.getMargin());
+      return copy;
+    }
+    const auto& hull = static_cast<const btConvexHullShape&>(shape);
+    auto copy = std::make_unique<btConvexHullShape>(&hull.getUnscaledPoints()->getX(), hull.getNumPoints());
+    copy->setMargin(hull.getMargin());
+    return copy;
   }
 };
 
@@ -57,7 +81,20 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
     }
     hull->recalcLocalAabb();
     hull->setMargin(margin * kUnitsPerMetre);
-    impl_->add(member, std::move(hull), offset);
+    if (mesh.pieces.size() > 1) {  // authored as convex pieces: each is what it is
+      impl_->add(member, std::move(hull), offset);
+      continue;
+    }
+    // One piece, maybe concave (a bracket, a housing with a bore): its hull is only the
+    // coarse test; the exact one goes by its triangles.
+    impl_->coarse.add(member, std::move(hull), to_bullet(offset));
+    for (const auto& t : mesh.triangles) {
+      auto triangle = std::make_unique<btTriangleShape>(to_bullet(mesh.vertices[t[0]]), to_bullet(mesh.vertices[t[1]]),
+                                                        to_bullet(mesh.vertices[t[2]]));
+      triangle->setMargin(margin * kUnitsPerMetre);
+      impl_->exact.add(member, std::move(triangle), to_bullet(offset));
+    }
+    impl_->has_exact = true;
   }
 }
 
@@ -69,7 +106,7 @@ void MovingBody::add_box(const std::string& member, const Eigen::Vector3d& half_
   impl_->add(member, std::move(box), offset);
 }
 
-bool MovingBody::empty() const { return impl_->shapes.empty(); }
+bool MovingBody::empty() const { return impl_->coarse.shapes.empty(); }
 
 Pose interpolate(const Pose& from, const Pose& to, double s) {
   Pose pose = Pose::Identity();
@@ -204,18 +241,23 @@ void CollisionWorld::remove(BodyId body) {
 
 std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const Pose& pose) const {
   ++checks_;
-  btCollisionObject& object = body.impl_->object;
-  object.setWorldTransform(to_bullet(pose));
-  DeepestContact callback(&object, options_.contact_tolerance);
-  impl_->world.contactTest(&object, callback);
-  if (!callback.deepest) return std::nullopt;
-  Contact c = *callback.deepest;
-  c.body_name = impl_->bodies.at(c.body).name;
-  const auto& members = body.impl_->member_of_child;
-  if (callback.self_child >= 0 && callback.self_child < static_cast<int>(members.size())) {
-    c.member = members[callback.self_child];
-  }
-  return c;
+  const auto deepest = [&](MovingBody::Impl::Shape& shape) -> std::optional<Contact> {
+    btCollisionObject& object = shape.object;
+    object.setWorldTransform(to_bullet(pose));
+    DeepestContact callback(&object, options_.contact_tolerance);
+    impl_->world.contactTest(&object, callback);
+    if (!callback.deepest) return std::nullopt;
+    Contact c = *callback.deepest;
+    c.body_name = impl_->bodies.at(c.body).name;
+    const auto& members = shape.member_of_child;
+    if (callback.self_child >= 0 && callback.self_child < static_cast<int>(members.size())) {
+      c.member = members[callback.self_child];
+    }
+    return c;
+  };
+  auto contact = deepest(body.impl_->coarse);
+  if (!contact || !body.impl_->has_exact) return contact;
+  return deepest(body.impl_->exact);
 }
 
 namespace {
@@ -236,7 +278,7 @@ struct AnyOverlap : btBroadphaseAabbCallback {
 std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose& from, const Pose& to) const {
   const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
   const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
-  const btCollisionShape& shape = body.impl_->compound;
+  const btCollisionShape& shape = body.impl_->coarse.compound;
   const double pad = (angle * body.radius() + options_.shape_margin) * kUnitsPerMetre;
 
   std::optional<Contact> hit;

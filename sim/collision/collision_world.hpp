@@ -1,8 +1,9 @@
 #pragma once
 // The collision world: static bodies (assembled parts, concave: a compound of the mesh's
 // convex pieces, or a triangle-mesh BVH for a one-piece mesh, so that a peg can pass
-// through a hole; the station's surface as a box) and moving bodies (a compound of
-// convex pieces: the gripped part's convex decomposition plus the gripper and carriage).
+// through a hole; the station's surface as a box) and moving bodies (the gripped part and
+// the gripper and carriage: convex pieces where the mesh is authored so, and for a
+// one-piece mesh its hull first and, where the hull penetrates, its exact triangles).
 // Touching is not colliding: only penetration deeper than the contact tolerance counts.
 
 #include <memory>
@@ -47,7 +48,8 @@ class MovingBody {
   MovingBody(MovingBody&&) noexcept;
   MovingBody& operator=(MovingBody&&) noexcept;
 
-  // Each piece of the mesh becomes one convex hull (a mesh with one piece: its hull).
+  // Each piece of a mesh authored as pieces becomes one convex hull; a one-piece mesh, which
+  // may be concave, is checked by its hull and then, near contact, by its triangles.
   void add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin);
   void add_box(const std::string& member, const Eigen::Vector3d& half_extents, const Pose& offset, double margin);
   // Largest distance of any point from the body's origin: bounds how far points move when
@@ -57,9 +59,6 @@ class MovingBody {
 
  private:
   friend class CollisionWorld;
-
-// The pose a fraction s (0..1) of the way: translation linear, rotation slerp.
-Pose interpolate(const Pose& from, const Pose& to, double s);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   double radius_ = 0;

@@ -89,3 +89,68 @@ TEST_CASE("Lego: a brick slides onto a brick and sits on it", "[collision][lego]
   CHECK_FALSE(world.sweep(moving, at(0.004, 0.1, 0), at(0.004, 0.0096, 0)));   // comes down onto it
   CHECK(world.sweep(moving, at(0.1, 0.0090, 0), at(0.004, 0.0090, 0)));        // 0.6 mm too low
 }
+
+namespace {
+
+// A square frame of one piece (a single mesh object, concave): four bars around a square
+// hole of 2 * `hole` on a side, `thickness` high along y. Its hull fills the hole.
+sim::TriangleMesh one_piece_frame(double hole, double bar, double thickness) {
+  sim::TriangleMesh mesh;
+  mesh.pieces.emplace_back();
+  const auto add_box = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    const auto first = static_cast<std::uint32_t>(mesh.vertices.size());
+    for (int i = 0; i < 8; ++i) {
+      mesh.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+      mesh.pieces.back().push_back(first + i);
+      mesh.bounds.extend(mesh.vertices.back());
+    }
+    for (const auto& f : std::vector<std::array<std::uint32_t, 4>>{
+             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
+      mesh.triangles.push_back({first + f[0], first + f[1], first + f[2]});
+      mesh.triangles.push_back({first + f[0], first + f[2], first + f[3]});
+    }
+  };
+  const double out = hole + bar, h = thickness / 2;
+  add_box({-out, -h, -out}, {-hole, h, out});  // left
+  add_box({hole, -h, -out}, {out, h, out});    // right
+  add_box({-hole, -h, -out}, {hole, h, -hole});  // front
+  add_box({-hole, -h, hole}, {hole, h, out});    // back
+  return mesh;
+}
+
+}  // namespace
+
+TEST_CASE("a one-piece concave part that moves is checked by its triangles, not by its hull", "[collision][exact]") {
+  sim::CollisionWorld world;  // contact tolerance 0.3 mm
+  const double hole = 0.010;  // a 20 mm square hole in the frame
+  sim::MovingBody frame;
+  frame.add_mesh("part", one_piece_frame(hole, 0.010, 0.010), sim::Pose::Identity(), world.options().shape_margin);
+
+  SECTION("a 0.2 mm clearance fit goes over the post, down its whole length") {
+    world.add_static_box("post", {hole - 0.0002, 0.05, hole - 0.0002}, at(0, 0, 0));
+    CHECK_FALSE(world.penetration(frame, at(0, 0, 0)));
+    CHECK_FALSE(world.sweep(frame, at(0, 0.1, 0), at(0, -0.03, 0)));
+    const auto aside = world.penetration(frame, at(0.001, 0, 0));  // 1 mm to the side: 0.8 mm into the post
+    REQUIRE(aside);
+    CHECK(aside->body_name == "post");
+    CHECK(aside->member == "part");
+    CHECK(aside->depth == Approx(0.0008).margin(2e-4));
+  }
+  SECTION("a 0.4 mm interference is caught, with its depth") {
+    world.add_static_box("post", {hole + 0.0004, 0.05, hole + 0.0004}, at(0, 0, 0));
+    const auto hit = world.penetration(frame, at(0, 0, 0));
+    REQUIRE(hit);
+    CHECK(hit->depth == Approx(0.0004).margin(1.5e-4));
+    const auto swept = world.sweep(frame, at(0, 0.1, 0), at(0, -0.03, 0));
+    REQUIRE(swept);
+    CHECK(swept->body_name == "post");
+  }
+  SECTION("against a one-piece concave static part too: the frame slides into a frame's opening") {
+    // A bigger frame lies flat; the small one goes down through its 40 mm hole with 1 mm
+    // to spare on every side and would hit it 2 mm off to the side.
+    auto big = std::make_shared<sim::TriangleMesh>(one_piece_frame(0.021, 0.010, 0.010));
+    world.add_static_mesh("big frame", big, at(0, 0, 0));
+    CHECK_FALSE(world.sweep(frame, at(0, 0.1, 0), at(0, -0.1, 0)));
+    CHECK(world.sweep(frame, at(0.002, 0.1, 0), at(0.002, -0.1, 0)));
+  }
+}
