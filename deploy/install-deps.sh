@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libbullet-dev libpugixml-dev catch2
   libassimp-dev libtinygltf-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libyaml-cpp-dev
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
-  libbenchmark-dev libsqlite3-dev sqlite3
+  libbenchmark-dev libsqlite3-dev sqlite3 libcgal-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
 )
 

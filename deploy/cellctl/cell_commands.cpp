@@ -375,11 +375,21 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   add_cell_options(submit_cmd, *cell_options);
   add_submit_options(submit_cmd, *submit_options, false);
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
-    const CellConfig cell = cell_options->load();
+    CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
     CellObserver observer(cell.domain, cell.localhost_only);
     auto orders = orders_of(*submit_options);
-    if (!running_state_dir(cell.domain).empty()) {
+    // Read once: an up that started after load() looked (its pid file is new) keeps its
+    // state where it says, and that is where its desk reads orders.
+    if (const std::string running = running_state_dir(cell.domain); !running.empty()) {
+      if (cell_options->state_dir.empty()) {
+        cell.state_dir = running;
+      } else if (fs::weakly_canonical(cell.state_folder()) != fs::weakly_canonical(running)) {
+        std::cerr << "error: the cell on domain " << cell.domain << " keeps its state in " << running << ", not in "
+                  << cell.state_folder().string() << "; submit without --state-dir\n";
+        exit_code = 2;
+        return;
+      }
       exit_code = submit_to_desk(cell, *submit_options, orders.front(), observer);
       return;
     }

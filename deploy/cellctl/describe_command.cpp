@@ -20,10 +20,12 @@ void add_describe_command(CLI::App& app, int& exit_code) {
   cmd->callback([options, &exit_code] {
     sim::MeshCache meshes;
     const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
+    // Overlaps are findings for the designer, not errors: the exit code stays 0.
+    const twin::InterferenceCheck check = twin::find_interferences(loaded);
     if (options->json) {
-      std::cout << product_json(loaded.product).dump(2) << '\n';
+      std::cout << product_json(loaded.product, check).dump(2) << '\n';
     } else {
-      print_product_table(loaded.product, std::cout);
+      print_product_table(loaded.product, check, std::cout);
     }
     exit_code = 0;
   });

@@ -11,7 +11,7 @@ twin::Vec3 xyz_degrees(const twin::Quat& q) {
   return twin::Vec3(zyx[2], zyx[1], zyx[0]) * (180.0 / M_PI);
 }
 
-nlohmann::json product_json(const twin::Product& product) {
+nlohmann::json product_json(const twin::Product& product, const twin::InterferenceCheck& check) {
   nlohmann::json parts = nlohmann::json::array();
   for (const auto& part : product.parts()) {
     const twin::Vec3 p = part.final_pose.translation();
@@ -33,16 +33,27 @@ nlohmann::json product_json(const twin::Product& product) {
                            {"interface2", c.interface2},
                            {"name", c.name}});
   }
+  nlohmann::json interferences = nlohmann::json::array();
+  for (const auto& i : check.overlaps) {
+    interferences.push_back({{"part1", product.parts()[i.part1].name},
+                             {"part2", product.parts()[i.part2].name},
+                             {"depth", i.depth},
+                             {"message", twin::describe(product, i)}});
+  }
+  nlohmann::json not_closed = nlohmann::json::array();
+  for (const auto p : check.not_closed) not_closed.push_back(product.parts()[p].name);
   return {{"schema", "agile-cell/product"},
           {"version", 1},
           {"product", product.name()},
           {"source", product.source().string()},
           {"units", {{"length", "m"}}},
           {"parts", parts},
-          {"connections", connections}};
+          {"connections", connections},
+          {"interferences", interferences},
+          {"meshes_not_closed", not_closed}};
 }
 
-void print_product_table(const twin::Product& product, std::ostream& out) {
+void print_product_table(const twin::Product& product, const twin::InterferenceCheck& check, std::ostream& out) {
   out << "Product '" << product.name() << "' from " << product.source().string() << ": "
       << product.parts().size() << " parts, " << product.connections().size() << " links\n\n";
   TextTable parts({"#", "part", "type", "color", "x mm", "y mm", "z mm", "rx deg", "ry deg", "rz deg", "mesh"});
@@ -61,6 +72,23 @@ void print_product_table(const twin::Product& product, std::ostream& out) {
     links.add_row({c.name, product.parts()[c.part1].name, c.interface1, product.parts()[c.part2].name, c.interface2});
   }
   links.print(out);
+  out << '\n';
+  if (check.overlaps.empty()) {
+    out << "No parts overlap in the finished product.\n";
+  } else {
+    out << check.overlaps.size() << " overlap" << (check.overlaps.size() == 1 ? "" : "s")
+        << " in the finished product (no plan can build these):\n";
+    TextTable overlaps({"part", "overlaps", "depth mm", "finding"});
+    for (const auto& i : check.overlaps) {
+      overlaps.add_row({product.parts()[i.part2].name, product.parts()[i.part1].name, fixed(i.depth * 1000, 2),
+                        twin::describe(product, i)});
+    }
+    overlaps.print(out);
+  }
+  for (const auto p : check.not_closed) {
+    out << "note: the mesh of " << product.parts()[p].name
+        << " is not closed: it has no inside, and overlaps into it are not checked\n";
+  }
 }
 
 }  // namespace cellctl

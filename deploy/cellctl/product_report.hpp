@@ -6,12 +6,14 @@
 #include <nlohmann/json.hpp>
 
 #include "twin/model/product.hpp"
+#include "twin/planning/interference.hpp"
 
 namespace cellctl {
 
-// Schema "agile-cell/product" version 1, documented in docs/cli.md.
-nlohmann::json product_json(const twin::Product& product);
-void print_product_table(const twin::Product& product, std::ostream& out);
+// Schema "agile-cell/product" version 1, documented in docs/cli.md. With the finished
+// product's interference check: the parts that overlap, and those whose mesh is not closed.
+nlohmann::json product_json(const twin::Product& product, const twin::InterferenceCheck& check);
+void print_product_table(const twin::Product& product, const twin::InterferenceCheck& check, std::ostream& out);
 
 // Extrinsic X, Y, Z angles in degrees (the orientation attribute's own convention).
 twin::Vec3 xyz_degrees(const twin::Quat& q);

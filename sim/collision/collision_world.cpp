@@ -81,7 +81,7 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
     }
     hull->recalcLocalAabb();
     hull->setMargin(margin * kUnitsPerMetre);
-    if (mesh.pieces.size() > 1) {  // authored as convex pieces: each is what it is
+    if (mesh.pieces.size() > 1 || mesh.convex) {  // convex pieces, or convex: the hull is exact
       impl_->add(member, std::move(hull), offset);
       continue;
     }

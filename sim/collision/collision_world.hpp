@@ -48,8 +48,11 @@ class MovingBody {
   MovingBody(MovingBody&&) noexcept;
   MovingBody& operator=(MovingBody&&) noexcept;
 
-  // Each piece of a mesh authored as pieces becomes one convex hull; a one-piece mesh, which
-  // may be concave, is checked by its hull and then, near contact, by its triangles.
+  // Each piece of a mesh authored as pieces becomes one convex hull, and so does a convex
+  // mesh; a concave one-piece mesh is checked by its hull and then, near contact, by its
+  // triangles. Triangles are a surface: two faces that overlap flat, where no triangles
+  // cross, go unseen (the finished product's interference check, which is volumetric,
+  // catches those at the final poses).
   void add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin);
   void add_box(const std::string& member, const Eigen::Vector3d& half_extents, const Pose& offset, double margin);
   // Largest distance of any point from the body's origin: bounds how far points move when

@@ -1,5 +1,9 @@
 #include "sim/mesh/triangle_mesh.hpp"
 
+#include <LinearMath/btConvexHullComputer.h>
+
+#include <cmath>
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -45,7 +49,33 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file)
   for (const auto& v : mesh->vertices) {
     if (!v.allFinite()) throw MeshError("mesh " + file.string() + " has a vertex that is not finite");
   }
+  mesh->convex = is_convex(*mesh);
   return mesh;
+}
+
+bool is_convex(const TriangleMesh& mesh) {
+  if (mesh.pieces.size() != 1 || mesh.vertices.size() < 4) return false;
+  const auto tetra = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    return a.dot(b.cross(c)) / 6;
+  };
+  double volume = 0;
+  for (const auto& t : mesh.triangles) volume += tetra(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
+  btConvexHullComputer hull;
+  hull.compute(mesh.vertices.front().data(), sizeof(Eigen::Vector3d), static_cast<int>(mesh.vertices.size()), 0, 0);
+  const auto vertex = [&](int i) {
+    const btVector3& v = hull.vertices[i];
+    return Eigen::Vector3d(v.x(), v.y(), v.z());
+  };
+  double hull_volume = 0;
+  for (int f = 0; f < hull.faces.size(); ++f) {
+    const btConvexHullComputer::Edge* first = &hull.edges[hull.faces[f]];
+    const int a = first->getSourceVertex();
+    for (auto* e = first->getNextEdgeOfFace(); e->getTargetVertex() != a; e = e->getNextEdgeOfFace()) {
+      hull_volume += tetra(vertex(a), vertex(e->getSourceVertex()), vertex(e->getTargetVertex()));
+    }
+  }
+  hull_volume = std::abs(hull_volume);
+  return hull_volume > 0 && std::abs(volume) >= (1 - 1e-3) * hull_volume && std::abs(volume) <= (1 + 1e-3) * hull_volume;
 }
 
 std::shared_ptr<const TriangleMesh> MeshCache::get(const std::filesystem::path& file) {

@@ -21,7 +21,13 @@ struct TriangleMesh {
   // indices. A mesh authored as a convex decomposition has one convex object per piece.
   std::vector<std::vector<std::uint32_t>> pieces;
   Eigen::AlignedBox3d bounds;
+  // One closed piece whose surface is its convex hull (a box, a pin): its hull is exact.
+  // False for anything concave, open or inconsistently wound, which is the safe side.
+  bool convex = false;
 };
+
+// Whether the mesh is one closed convex piece: its volume is its hull's (to 0.1 %).
+bool is_convex(const TriangleMesh& mesh);
 
 class MeshError : public std::runtime_error {
  public:

@@ -389,6 +389,7 @@ TEST_CASE("hostile: a give without an award is rejected and the stock stays", "[
   const auto before = stock();
   cell::Command give = command("rogue/give", "buffer-2", "rogue", "give", "rogue/give/Brick2x4");
   give.part_type("Brick2x4");
+  give.destination("rogue-robot");
   REQUIRE(cell.send(give));
   CHECK(rejection(cell, "rogue/give") == "buffer-2 has no award rogue/give/Brick2x4 of order rogue");
   CHECK(stock() == before);

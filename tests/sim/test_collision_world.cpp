@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include "sim/collision/collision_world.hpp"
+#include "tests/support/meshes.hpp"
 
 namespace {
 
@@ -90,41 +91,11 @@ TEST_CASE("Lego: a brick slides onto a brick and sits on it", "[collision][lego]
   CHECK(world.sweep(moving, at(0.1, 0.0090, 0), at(0.004, 0.0090, 0)));        // 0.6 mm too low
 }
 
-namespace {
-
-// A square frame of one piece (a single mesh object, concave): four bars around a square
-// hole of 2 * `hole` on a side, `thickness` high along y. Its hull fills the hole.
-sim::TriangleMesh one_piece_frame(double hole, double bar, double thickness) {
-  sim::TriangleMesh mesh;
-  mesh.pieces.emplace_back();
-  const auto add_box = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-    const auto first = static_cast<std::uint32_t>(mesh.vertices.size());
-    for (int i = 0; i < 8; ++i) {
-      mesh.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-      mesh.pieces.back().push_back(first + i);
-      mesh.bounds.extend(mesh.vertices.back());
-    }
-    for (const auto& f : std::vector<std::array<std::uint32_t, 4>>{
-             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
-      mesh.triangles.push_back({first + f[0], first + f[1], first + f[2]});
-      mesh.triangles.push_back({first + f[0], first + f[2], first + f[3]});
-    }
-  };
-  const double out = hole + bar, h = thickness / 2;
-  add_box({-out, -h, -out}, {-hole, h, out});  // left
-  add_box({hole, -h, -out}, {out, h, out});    // right
-  add_box({-hole, -h, -out}, {hole, h, -hole});  // front
-  add_box({-hole, -h, hole}, {hole, h, out});    // back
-  return mesh;
-}
-
-}  // namespace
-
 TEST_CASE("a one-piece concave part that moves is checked by its triangles, not by its hull", "[collision][exact]") {
   sim::CollisionWorld world;  // contact tolerance 0.3 mm
   const double hole = 0.010;  // a 20 mm square hole in the frame
   sim::MovingBody frame;
-  frame.add_mesh("part", one_piece_frame(hole, 0.010, 0.010), sim::Pose::Identity(), world.options().shape_margin);
+  frame.add_mesh("part", test::one_piece_frame(hole, 0.010, 0.010), sim::Pose::Identity(), world.options().shape_margin);
 
   SECTION("a 0.2 mm clearance fit goes over the post, down its whole length") {
     world.add_static_box("post", {hole - 0.0002, 0.05, hole - 0.0002}, at(0, 0, 0));
@@ -148,7 +119,7 @@ TEST_CASE("a one-piece concave part that moves is checked by its triangles, not 
   SECTION("against a one-piece concave static part too: the frame slides into a frame's opening") {
     // A bigger frame lies flat; the small one goes down through its 40 mm hole with 1 mm
     // to spare on every side and would hit it 2 mm off to the side.
-    auto big = std::make_shared<sim::TriangleMesh>(one_piece_frame(0.021, 0.010, 0.010));
+    auto big = std::make_shared<sim::TriangleMesh>(test::one_piece_frame(0.021, 0.010, 0.010));
     world.add_static_mesh("big frame", big, at(0, 0, 0));
     CHECK_FALSE(world.sweep(frame, at(0, 0.1, 0), at(0, -0.1, 0)));
     CHECK(world.sweep(frame, at(0.002, 0.1, 0), at(0.002, -0.1, 0)));

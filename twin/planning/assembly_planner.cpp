@@ -1,7 +1,10 @@
 #include "twin/planning/assembly_planner.hpp"
 
+#include "twin/planning/interference.hpp"
+
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 #include <unordered_set>
 
@@ -14,9 +17,9 @@ std::string millimetres(double metres) {
   return buffer;
 }
 
-std::string join(const std::vector<std::string>& names) {
+std::string join(const std::vector<std::string>& names, const std::string& separator = ", ") {
   std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  for (const auto& n : names) out += (out.empty() ? "" : separator) + n;
   return out;
 }
 
@@ -29,6 +32,11 @@ class Search {
   Plan run() {
     plan_.sequence_planner = sequence_.name();
     plan_.path_planner = path_.name();
+    // Overlaps in the finished product first: no path can resolve them.
+    for (const Interference& i : find_interferences(product_, options_.collision.contact_tolerance).overlaps) {
+      plan_.findings.push_back({"interference", describe(product_.product, i), {name(i.part2), name(i.part1)}});
+      interferences_.push_back(i);
+    }
     for (const PlanStep& step : options_.given) {
       assembled_[step.part] = true;
       scene_.assemble(step.part);
@@ -50,6 +58,14 @@ class Search {
     const std::vector<PartIndex> allowed(scene_.frontier().begin(), scene_.frontier().end());
     for (PartIndex part : sequence_.candidates(scene_)) {
       if (plan_.steps.size() == options_.given.size() && options_.not_next.count(part)) continue;
+      tried_.insert(part);
+      // A part that overlaps one in place in the finished product goes in on no path.
+      if (const auto other = overlapping_assembled(part)) {
+        blocked_by_[part].insert(name(*other));
+        unplaceable_.insert(part);
+        if (!sequence_.backtracks()) return give_up(part);
+        continue;
+      }
       std::vector<Attempt> tried;
       std::optional<Trajectory> trajectory;
       while ((trajectory = path_.next(scene_, part, tried))) {
@@ -57,11 +73,12 @@ class Search {
         auto collision = scene_.simulate(part, *trajectory);
         if (!collision) break;
         blocked_by_[part].insert(collision->with);
+        if (!worst_.count(part) || collision->depth > worst_[part].depth) worst_[part] = *collision;
         tried.push_back({std::move(*trajectory), collision});
       }
       if (!trajectory) {
         unplaceable_.insert(part);
-        if (!sequence_.backtracks()) return give_up();
+        if (!sequence_.backtracks()) return give_up(part);
         continue;
       }
       assembled_[part] = true;
@@ -86,9 +103,45 @@ class Search {
     return false;
   }
 
-  bool give_up() {
+  // A sequence that does not backtrack ends at its first part that cannot go in.
+  bool give_up(PartIndex part) {
     stopped_ = true;
+    stopped_at_ = {part, plan_.steps.size() + 1};
     return false;
+  }
+
+  std::optional<PartIndex> overlapping_assembled(PartIndex part) const {
+    for (const Interference& i : interferences_) {
+      if (i.part1 == part && assembled_[i.part2]) return i.part2;
+      if (i.part2 == part && assembled_[i.part1]) return i.part1;
+    }
+    return std::nullopt;
+  }
+
+  // Why a part is not in the plan, as far as the search knows.
+  std::string why_not(PartIndex p) {
+    if (unplaceable_.count(p)) {
+      const auto& blockers = blocked_by_[p];
+      std::vector<std::string> why;
+      if (const auto worst = worst_.find(p); worst != worst_.end()) {
+        const Collision& c = worst->second;
+        why.push_back("no collision-free path; blocked by " + join({blockers.begin(), blockers.end()}) +
+                      " (deepest: the " + c.member + " hit " + c.with + " " + millimetres(c.depth) + " deep while " +
+                      c.phase + ")");
+      }
+      for (const Interference& i : interferences_) {
+        const PartIndex other = i.part1 == p ? i.part2 : i.part2 == p ? i.part1 : p;
+        if (other != p && blockers.count(name(other))) why.push_back(describe(product_.product, i));
+      }
+      return why.empty() ? "the path planner had no trajectory for it" : join(why, "; ");
+    }
+    if (stopped_at_) {
+      return "not tried after step " + std::to_string(stopped_at_->second) + " failed (" + name(stopped_at_->first) +
+             "): the " + sequence_.name() + " sequence does not go back";
+    }
+    if (tried_.count(p)) return "it went in at times, but the remaining parts could not be completed after it";
+    if (stopped_) return "not in place when the search stopped after " + std::to_string(plan_.backtracks) + " backtracks";
+    return "never reachable: the parts it is linked to could not be assembled";
   }
 
   void report() {
@@ -118,12 +171,9 @@ class Search {
       for (const auto& s : plan_.steps) in[s.part] = true;
       for (PartIndex p = 0; p < in.size(); ++p) {
         if (in[p]) continue;
-        std::vector<std::string> blockers(blocked_by_[p].begin(), blocked_by_[p].end());
-        std::string why = unplaceable_.count(p) ? "no collision-free path; blocked by " + join(blockers)
-                                                : "never reachable: the parts it is linked to could not be assembled";
-        if (unplaceable_.count(p) && blockers.empty()) why = "the path planner had no trajectory for it";
         std::vector<std::string> parts = {name(p)};
-        parts.insert(parts.end(), blockers.begin(), blockers.end());
+        parts.insert(parts.end(), blocked_by_[p].begin(), blocked_by_[p].end());
+        const std::string why = why_not(p);
         plan_.findings.push_back({"infeasible", name(p) + ": " + why, parts});
       }
     }
@@ -155,7 +205,11 @@ class Search {
   std::map<PartIndex, std::set<std::string>> blocked_by_;
   std::set<PartIndex> unplaceable_;
   std::set<PartIndex> backtracked_;
+  std::set<PartIndex> tried_;
+  std::map<PartIndex, Collision> worst_;  // the deepest collision of each part's tries
+  std::vector<Interference> interferences_;
   bool stopped_ = false;
+  std::optional<std::pair<PartIndex, std::size_t>> stopped_at_;  // the part and step a sequence ended at
 };
 
 }  // namespace
