@@ -33,7 +33,7 @@ class Search {
     plan_.sequence_planner = sequence_.name();
     plan_.path_planner = path_.name();
     // Overlaps in the finished product first: no path can resolve them.
-    for (const Interference& i : find_interferences(product_, options_.collision.contact_tolerance).overlaps) {
+    for (const Interference& i : find_interferences(product_, options_.collision).overlaps) {
       plan_.findings.push_back({"interference", describe(product_.product, i), {name(i.part2), name(i.part1)}});
       interferences_.push_back(i);
     }

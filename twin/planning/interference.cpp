@@ -118,7 +118,8 @@ double depth_into(const Solid& a, const Pose& a_pose, const Solid& b, const Pose
 
 }  // namespace
 
-InterferenceCheck find_interferences(const LoadedProduct& product, double tolerance) {
+InterferenceCheck find_interferences(const LoadedProduct& product, const sim::CollisionOptions& options) {
+  const double tolerance = options.contact_tolerance;
   const auto& parts = product.product.parts();
   std::vector<Eigen::AlignedBox3d> boxes(parts.size());
   for (PartIndex i = 0; i < parts.size(); ++i) {
@@ -134,12 +135,29 @@ InterferenceCheck find_interferences(const LoadedProduct& product, double tolera
     if (!s) s = solid_of(*product.meshes[i]);
     return *s;
   };
+  // A convex part (or one authored as convex pieces) is a volume to Bullet: when its hull
+  // reaches no deeper than the tolerance into the other part and does not lie wholly inside
+  // it, the two do not overlap, and the sampled check is spared (a peg in its hole).
+  const auto clear_to_bullet = [&](PartIndex moving, PartIndex fixed) {
+    const sim::TriangleMesh& mesh = *product.meshes[moving];
+    if (!mesh.convex && mesh.pieces.size() < 2) return false;
+    sim::CollisionWorld world(options);
+    world.add_static_mesh(parts[fixed].name, product.meshes[fixed], parts[fixed].final_pose);
+    sim::MovingBody body;
+    body.add_mesh("part", mesh, Pose::Identity(), options.shape_margin);
+    if (world.penetration(body, parts[moving].final_pose)) return false;
+    const Solid& other = solid(fixed);
+    if (!other.inside) return true;
+    const Point corner = point(parts[fixed].final_pose.inverse() * (parts[moving].final_pose * mesh.vertices.front()));
+    return std::sqrt(other.surface->squared_distance(corner)) <= tolerance || !other.contains(corner);
+  };
   InterferenceCheck check;
   for (PartIndex i = 0; i < parts.size(); ++i) {
     for (PartIndex j = i + 1; j < parts.size(); ++j) {
       if (boxes[i].isEmpty() || boxes[j].isEmpty()) continue;
       const Eigen::AlignedBox3d common = boxes[i].intersection(boxes[j]);
       if (common.isEmpty() || common.sizes().minCoeff() <= tolerance) continue;
+      if (clear_to_bullet(i, j) || clear_to_bullet(j, i)) continue;
       const Pose &pi = parts[i].final_pose, &pj = parts[j].final_pose;
       const double depth = std::max(depth_into(solid(i), pi, solid(j), pj, common, tolerance),
                                     depth_into(solid(j), pj, solid(i), pi, common, tolerance));
