@@ -151,3 +151,34 @@ TEST_CASE("no straight insertion: OMPL's RRT-Connect finds a path, checked in th
   }
   CHECK_FALSE(scene.simulate(step.part, step.trajectory));
 }
+
+TEST_CASE("lipped box: one-piece concave walls go straight down, the wide block goes in before the last wall",
+          "[planning][concave]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan p = plan(test::data("planning/lipped-box/lipped-box.aml"), "search", cache, loaded);
+  REQUIRE(p.complete);
+  const auto o = order(loaded, p);
+  for (const char* wall : {"wall_left", "wall_right", "wall_front", "wall_back"}) {
+    const auto& mesh = *loaded.meshes[*loaded.product.find_part_by_name(wall)];
+    CHECK_FALSE(mesh.convex);  // a slab and a lip in one piece
+    CHECK(p.steps[at(o, wall)].trajectory.label == "down");
+  }
+  // Too wide for the opening between the lips: in before the last wall, from its side.
+  const auto& block = p.steps[at(o, "block")];
+  CHECK(at(o, "block") == o.size() - 2);
+  CHECK(std::abs(block.trajectory.direction.y()) < 1e-9);
+
+  // Its walls' hulls would fill the space under the lips, where the block stands.
+  sim::CollisionWorld world;
+  const auto index = [&](const char* name) { return *loaded.product.find_part_by_name(name); };
+  world.add_static_mesh("block", loaded.meshes[index("block")], loaded.product.parts()[index("block")].final_pose);
+  const auto& wall = loaded.product.parts()[index("wall_left")];
+  sim::MovingBody exact, hull;
+  exact.add_mesh("part", *loaded.meshes[index("wall_left")], twin::Pose::Identity(), world.options().shape_margin);
+  sim::TriangleMesh as_hull = *loaded.meshes[index("wall_left")];
+  as_hull.convex = true;
+  hull.add_mesh("part", as_hull, twin::Pose::Identity(), world.options().shape_margin);
+  CHECK_FALSE(world.penetration(exact, wall.final_pose));
+  CHECK(world.penetration(hull, wall.final_pose));
+}
