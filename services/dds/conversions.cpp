@@ -180,6 +180,7 @@ cell::SimRequest to_sim_request(const fb::Data& d) {
   r.scene(id(d, "scene"));
   r.fixture(fb::get_or<bool>(d, "fixture", false));
   r.mesh_uri(path_text(d, "mesh_uri"));
+  r.mesh_scale(fb::get_or<double>(d, "mesh_scale", 1));
   r.half_extents(to_vec3(fb::get_or<fb::Numbers>(d, "half_extents", {0, 0, 0})));
   const auto placement = to_path(fb::get_or<fb::Numbers>(d, "placement", {0, 0, 0, 1, 0, 0, 0}));
   if (placement.size() != 1) throw std::invalid_argument("a placement is one pose");
@@ -205,6 +206,7 @@ fb::Data to_data(const cell::SimRequest& r) {
           {"scene", r.scene().to_string()},
           {"fixture", r.fixture()},
           {"mesh_uri", r.mesh_uri().to_string()},
+          {"mesh_scale", r.mesh_scale()},
           {"half_extents", to_numbers(r.half_extents())},
           {"placement", to_numbers(std::vector<cell::Pose>{r.placement()})},
           {"is_static", r.is_static()},

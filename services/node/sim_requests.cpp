@@ -8,8 +8,9 @@ Data SimRequests::request(const std::string& kind, const std::string& body) {
 }
 
 Data SimRequests::spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents,
-                        bool is_static, const std::string& mesh_uri, const std::string& scene) {
+                        bool is_static, const std::string& mesh_uri, const std::string& scene, double mesh_scale) {
   Data d = request("spawn", body);
+  d["mesh_scale"] = mesh_scale;
   d["placement"] = placement;
   d["half_extents"] = half_extents;
   d["is_static"] = is_static;

@@ -20,7 +20,7 @@ class SimRequests {
 
   // `scene`: where the body lives ("" the physical cell, else a virtual scene).
   Data spawn(const std::string& body, const Numbers& placement, const Numbers& half_extents, bool is_static,
-             const std::string& mesh_uri = "", const std::string& scene = "");
+             const std::string& mesh_uri = "", const std::string& scene = "", double mesh_scale = 1);
   // A static body of the cell that every scene sees (a station's table).
   Data spawn_fixture(const std::string& body, const Numbers& placement, const Numbers& half_extents);
   Data remove(const std::string& body);

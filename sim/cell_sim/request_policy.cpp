@@ -10,6 +10,7 @@ namespace {
 constexpr std::uintmax_t kMaxMeshBytes = 64u << 20;
 constexpr std::size_t kMaxCarried = 64;
 constexpr std::size_t kMaxPathLength = 4095;  // FilePath of the IDL
+constexpr double kMinMeshScale = 1e-6, kMaxMeshScale = 1e3;  // micrometres to kilometres
 
 std::string text(const fb::Data& d, const char* key) { return fb::get_or<std::string>(d, key, ""); }
 
@@ -22,6 +23,10 @@ std::string RequestPolicy::well_formed(const fb::Data& d) const {
   if (kind != "ping") c.text("body_id", true);
   if (kind == "spawn") {
     c.poses("placement", 1, 1).non_negative_vector("half_extents").text("mesh_uri", false, kMaxPathLength);
+    c.finite("mesh_scale");
+    const double scale = fb::get_or<double>(d, "mesh_scale", 1);
+    c.require(scale == 0 || (scale >= kMinMeshScale && scale <= kMaxMeshScale),
+              "mesh_scale: " + std::to_string(scale) + " metres per unit is not a length unit (1e-6 to 1000)");
     const std::string mesh = text(d, "mesh_uri");
     if (c.ok() && !mesh.empty()) {
       std::error_code error;

@@ -69,9 +69,11 @@ void WorldBlock::handle(const fb::Data& d) {
       // gripper, its base) is replaced.
       if (world_.pose(id) && policy_.owner_of(id) == fb::get<std::string>(d, "requester")) world_.remove(id);
       const fb::Numbers& h = fb::get<fb::Numbers>(d, "half_extents");
+      const double scale = fb::get_or<double>(d, "mesh_scale", 1);
       world_.spawn({id, fb::get_or<std::string>(d, "mesh_uri", ""), Eigen::Vector3d(h.at(0), h.at(1), h.at(2)),
                     pose_at(fb::get<fb::Numbers>(d, "placement"), 0), fb::get_or<bool>(d, "is_static", false),
-                    fb::get_or<std::string>(d, "scene", ""), fb::get_or<bool>(d, "fixture", false)});
+                    fb::get_or<std::string>(d, "scene", ""), fb::get_or<bool>(d, "fixture", false),
+                    scale > 0 ? scale : 1});
       policy_.spawned(id, fb::get<std::string>(d, "requester"));
     } else if (kind == "remove") {
       world_.remove(id);

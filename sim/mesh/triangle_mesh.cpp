@@ -36,7 +36,7 @@ void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
 
 }  // namespace
 
-std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file) {
+std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file, double scale) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(
       file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
@@ -46,6 +46,10 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file)
   auto mesh = std::make_shared<TriangleMesh>();
   append_node(*scene, *scene->mRootNode, aiMatrix4x4(), *mesh);
   if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds no triangles");
+  if (scale != 1) {
+    for (auto& v : mesh->vertices) v *= scale;
+    mesh->bounds = Eigen::AlignedBox3d(mesh->bounds.min() * scale, mesh->bounds.max() * scale);
+  }
   for (const auto& v : mesh->vertices) {
     if (!v.allFinite()) throw MeshError("mesh " + file.string() + " has a vertex that is not finite");
   }
@@ -78,10 +82,10 @@ bool is_convex(const TriangleMesh& mesh) {
   return hull_volume > 0 && std::abs(volume) >= (1 - 1e-3) * hull_volume && std::abs(volume) <= (1 + 1e-3) * hull_volume;
 }
 
-std::shared_ptr<const TriangleMesh> MeshCache::get(const std::filesystem::path& file) {
-  const std::string key = file.string();
+std::shared_ptr<const TriangleMesh> MeshCache::get(const std::filesystem::path& file, double scale) {
+  const std::string key = file.string() + '@' + std::to_string(scale);
   if (auto it = meshes_.find(key); it != meshes_.end()) return it->second;
-  auto mesh = load_mesh(file);
+  auto mesh = load_mesh(file, scale);
   meshes_.emplace(key, mesh);
   return mesh;
 }

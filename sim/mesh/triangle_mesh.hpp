@@ -34,14 +34,15 @@ class MeshError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Reads OBJ, STL, COLLADA, PLY, glTF and the rest of what Assimp reads. Throws MeshError
-// when the file cannot be read or holds no triangles.
-std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file);
+// Reads OBJ, STL, COLLADA, PLY, glTF and the rest of what Assimp reads, its coordinates
+// times `scale` (metres per unit of the file: 0.001 for a CAD export in millimetres).
+// Throws MeshError when the file cannot be read or holds no triangles.
+std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file, double scale = 1);
 
 // Each file read once, shared by every part that uses it.
 class MeshCache {
  public:
-  std::shared_ptr<const TriangleMesh> get(const std::filesystem::path& file);
+  std::shared_ptr<const TriangleMesh> get(const std::filesystem::path& file, double scale = 1);
   std::size_t size() const { return meshes_.size(); }
 
  private:

@@ -32,7 +32,7 @@ void SimWorld::spawn(const BodySpec& spec) {
   Body body{spec, nullptr, {}};
   if (!spec.mesh_uri.empty()) {
     try {
-      body.mesh = meshes_.get(spec.mesh_uri);
+      body.mesh = meshes_.get(spec.mesh_uri, spec.mesh_scale);
     } catch (const MeshError& e) {
       throw SimError("body " + spec.id + ": " + e.what());
     }

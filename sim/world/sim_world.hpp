@@ -34,6 +34,7 @@ struct BodySpec {
   bool is_static = false;
   std::string scene;     // "" the physical cell
   bool fixture = false;  // static, in the physical cell, and seen from every scene
+  double mesh_scale = 1;  // metres per unit of the mesh file
 };
 
 struct MoveRequest {

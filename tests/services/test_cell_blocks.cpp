@@ -246,6 +246,11 @@ TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "
   CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "mesh_uri", std::string("/nonexistent.obj"))) ==
         "mesh_uri: /nonexistent.obj is not a readable file");
   CHECK(ask("intruder", "spawn", "x", with(box, "scene", std::string("ok1"))) == "scene ok1 is not intruder's");
+  CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "mesh_scale", -1.0)) ==
+        "mesh_scale: -1.000000 metres per unit is not a length unit (1e-6 to 1000)");
+  CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "mesh_scale", std::nan(""))) == "mesh_scale: nan is not finite");
+  CHECK(ask("ok1", "spawn", "ok1/mm", with(with(box, "mesh_uri", std::string(TEST_DATA_DIR "/planning/units/meshes/block_mm.stl")),
+                                           "mesh_scale", 1e-3)).empty());
 
   const fb::Data move{{"path", fb::Numbers{0.1, 0.5, 0, 1, 0, 0, 0}}, {"speed", 1.0}, {"angular_speed", 1.0}};
   CHECK(ask("ok1", "move", "ok1/B1", with(move, "speed", std::nan(""))) == "speed: nan is not finite");

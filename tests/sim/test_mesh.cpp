@@ -32,3 +32,23 @@ TEST_CASE("a file that is not a mesh is a MeshError", "[mesh]") {
   CHECK_THROWS_AS(sim::load_mesh(data("bad/meshes/garbage.obj")), sim::MeshError);
   CHECK_THROWS_AS(sim::load_mesh(data("bad/meshes/none.obj")), sim::MeshError);
 }
+
+TEST_CASE("a CAD export in millimetres: unwelded binary STL, scaled to metres, welded, known convex", "[mesh]") {
+  const auto block = sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3);
+  CHECK(block->triangles.size() == 12);
+  CHECK(block->vertices.size() == 8);  // 36 corners as written, 8 once welded
+  CHECK(block->bounds.min().isApprox(Eigen::Vector3d(-0.01, 0, -0.01), 1e-6));
+  CHECK(block->bounds.max().isApprox(Eigen::Vector3d(0.01, 0.02, 0.01), 1e-6));
+  CHECK(block->convex);
+
+  sim::MeshCache cache;  // a file at two scales is two meshes
+  CHECK(cache.get(data("planning/units/meshes/block_mm.stl"), 1e-3)->bounds.sizes().x() == Approx(0.02));
+  CHECK(cache.get(data("planning/units/meshes/block_mm.stl"))->bounds.sizes().x() == Approx(20));
+  CHECK(cache.size() == 2);
+}
+
+TEST_CASE("convexity: a box is convex, a frame of one piece and an open box are not", "[mesh]") {
+  CHECK(sim::load_mesh(data("planning/backtrack/meshes/block.obj"))->convex);
+  CHECK_FALSE(sim::load_mesh(data("planning/lipped-box/meshes/wall_left.obj"))->convex);
+  CHECK_FALSE(sim::load_mesh(products("cranfield/meshes/faceplate.obj"))->convex);  // many pieces
+}

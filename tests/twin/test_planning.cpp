@@ -182,3 +182,14 @@ TEST_CASE("lipped box: one-piece concave walls go straight down, the wide block 
   CHECK_FALSE(world.penetration(exact, wall.final_pose));
   CHECK(world.penetration(hull, wall.final_pose));
 }
+
+TEST_CASE("a mesh in millimetres (LengthUnit mm) is placed and planned in metres", "[planning][units]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan p = plan(test::data("planning/units/units.aml"), "search", cache, loaded);
+  REQUIRE(p.complete);
+  const auto& block = test::part(loaded.product, "block");
+  CHECK(block.mesh->scale == 1e-3);
+  CHECK(loaded.meshes[*loaded.product.find_part_by_name("block")]->bounds.sizes().y() == Approx(0.02));
+  CHECK(test::position_mm(loaded.product, "block").y() == Approx(10));  // on the 10 mm plate
+}

@@ -23,7 +23,7 @@ LoadedProduct load_product(const std::filesystem::path& file, sim::MeshCache& ca
       continue;
     }
     try {
-      loaded.meshes.push_back(cache.get(part.mesh->file));
+      loaded.meshes.push_back(cache.get(part.mesh->file, part.mesh->scale));
     } catch (const sim::MeshError& e) {
       throw DescriptionError(part.mesh->where, e.what());
     }

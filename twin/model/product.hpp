@@ -31,6 +31,7 @@ struct PartType {
 struct MeshRef {
   std::filesystem::path file;  // absolute, already checked to lie inside the product folder
   SourceRef where;
+  double scale = 1;  // metres per unit of the file (its LengthUnit: a CAD export is often in mm)
 };
 
 struct DigitalPart {

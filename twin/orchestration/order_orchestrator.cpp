@@ -365,8 +365,9 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
                     carriage = settings_.order_id + "/virtual/gripper-carriage";
   const std::string& scene = settings_.order_id;
   const auto& w = t.waypoints;
+  const MeshRef& mesh = *product_.product.parts()[part].mesh;
   actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at(virtual_station_, w.front().part)}), {0, 0, 0},
-                                              false, product_.product.parts()[part].mesh->file.string(), scene)});
+                                              false, mesh.file.string(), scene, mesh.scale)});
   const Numbers grasp = pose_numbers({at(virtual_station_, w.front().gripper)});
   const Vec3 half = scene_.pad_half_extents(part, t.grip_direction);
   const Numbers pad_half{half.x(), half.y(), half.z()};
@@ -491,9 +492,10 @@ void OrderOrchestrator::plan_physical() {
     const Pose final_pose = at(station_, part.final_pose);
     std::string body = physical_body(step.part);
     const std::string mesh = part.mesh->file.string();
+    const double scale = part.mesh->scale;
     if (const std::string* placed = body_in(resume.placed, body)) {  // done: it stands in the product
       body = *placed;
-      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({final_pose}), {0, 0, 0}, true, mesh)});
+      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({final_pose}), {0, 0, 0}, true, mesh, "", scale)});
       spawned_.insert(body);
       continue;
     }
@@ -501,7 +503,7 @@ void OrderOrchestrator::plan_physical() {
     if (const std::string* delivered = body_in(resume.delivered, body)) {  // at the dock, where a robot put it down
       body = *delivered;
       const Pose at_dock = with_translation(final_pose, dock[0], final_pose.translation().y(), dock[2]);
-      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at_dock}), {0, 0, 0}, false, mesh)});
+      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at_dock}), {0, 0, 0}, false, mesh, "", scale)});
       spawned_.insert(body);
       fetches.push_back("delivered/" + body);
       delivered_.insert(fetches.back());
@@ -512,7 +514,7 @@ void OrderOrchestrator::plan_physical() {
     const std::string& buffer = buffer_of_.at(type);
     const Numbers& source = places_.at(buffer).dock;
     const Pose in_buffer = with_translation(final_pose, source[0], final_pose.translation().y(), source[2]);
-    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, mesh)});
+    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, mesh, "", scale)});
     spawned_.insert(body);
     bodies.push_back(body);
     Data fetch = command(robot_, "fetch", body);

@@ -278,14 +278,20 @@ class CaexReader {
     for (const auto& holder : holders) {
       for (pugi::xml_node i = holder.first_child(); i; i = i.next_sibling()) {
         if (local_name(i) != "ExternalInterface") continue;
-        pugi::xml_node uri_attribute;
+        pugi::xml_node uri_attribute, unit_attribute;
         for_each_child(i, "Attribute", [&](const pugi::xml_node& a) {
-          if (std::string_view(a.attribute("Name").value()) == "refURI") uri_attribute = a;
+          const std::string_view name = a.attribute("Name").value();
+          if (name == "refURI") uri_attribute = a;
+          if (name == "LengthUnit") unit_attribute = a;
         });
         if (!uri_attribute) continue;
         const std::string uri = aml::attribute_text(uri_attribute).value_or("");
         if (!is_geometry_interface(i, uri)) continue;
-        return resolve_mesh(uri, file_.where(uri_attribute));
+        MeshRef mesh = resolve_mesh(uri, file_.where(uri_attribute));
+        if (unit_attribute) {
+          mesh.scale = aml::length_unit_scale(aml::attribute_text(unit_attribute).value_or(""), file_.where(unit_attribute));
+        }
+        return mesh;
       }
     }
     return std::nullopt;

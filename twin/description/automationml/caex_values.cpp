@@ -48,10 +48,11 @@ double length_unit_scale(const std::string& unit, const SourceRef& where) {
   static const std::map<std::string, double> scales = {
       {"", 1.0},       {"m", 1.0},        {"meter", 1.0},        {"metre", 1.0},
       {"mm", 1e-3},    {"millimeter", 1e-3}, {"millimetre", 1e-3}, {"cm", 1e-2},
-      {"centimeter", 1e-2}, {"centimetre", 1e-2}, {"dm", 1e-1},     {"km", 1e3}};
+      {"centimeter", 1e-2}, {"centimetre", 1e-2}, {"dm", 1e-1},     {"km", 1e3},
+      {"in", 0.0254},  {"inch", 0.0254}};
   const auto it = scales.find(unit);
   if (it == scales.end()) {
-    throw DescriptionError(where, "unknown length unit '" + unit + "' (expected m, cm or mm)");
+    throw DescriptionError(where, "unknown length unit '" + unit + "' (expected m, cm, mm or in)");
   }
   return it->second;
 }
