@@ -23,9 +23,9 @@ void add_describe_command(CLI::App& app, int& exit_code) {
     // Overlaps are findings for the designer, not errors: the exit code stays 0.
     const twin::InterferenceCheck check = twin::find_interferences(loaded);
     if (options->json) {
-      std::cout << product_json(loaded.product, check).dump(2) << '\n';
+      std::cout << product_json(loaded, check).dump(2) << '\n';
     } else {
-      print_product_table(loaded.product, check, std::cout);
+      print_product_table(loaded, check, std::cout);
     }
     exit_code = 0;
   });

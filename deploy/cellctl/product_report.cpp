@@ -1,6 +1,7 @@
 #include "deploy/cellctl/product_report.hpp"
 
 #include <cmath>
+#include <map>
 
 #include "deploy/cellctl/text_table.hpp"
 
@@ -11,7 +12,25 @@ twin::Vec3 xyz_degrees(const twin::Quat& q) {
   return twin::Vec3(zyx[2], zyx[1], zyx[0]) * (180.0 / M_PI);
 }
 
-nlohmann::json product_json(const twin::Product& product, const twin::InterferenceCheck& check) {
+namespace {
+
+// Mesh file -> (what loading repaired or found, the parts that use it), for the files with any.
+std::map<std::string, std::pair<std::string, std::vector<std::string>>> mesh_repairs(const twin::LoadedProduct& loaded) {
+  std::map<std::string, std::pair<std::string, std::vector<std::string>>> out;
+  for (std::size_t i = 0; i < loaded.meshes.size(); ++i) {
+    const auto& part = loaded.product.parts()[i];
+    if (!loaded.meshes[i] || !loaded.meshes[i]->repairs.any()) continue;
+    auto& entry = out[part.mesh->file.filename().string()];
+    entry.first = loaded.meshes[i]->repairs.describe();
+    entry.second.push_back(part.name);
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json product_json(const twin::LoadedProduct& loaded, const twin::InterferenceCheck& check) {
+  const twin::Product& product = loaded.product;
   nlohmann::json parts = nlohmann::json::array();
   for (const auto& part : product.parts()) {
     const twin::Vec3 p = part.final_pose.translation();
@@ -40,6 +59,10 @@ nlohmann::json product_json(const twin::Product& product, const twin::Interferen
                              {"depth", i.depth},
                              {"message", twin::describe(product, i)}});
   }
+  nlohmann::json repairs = nlohmann::json::array();
+  for (const auto& [file, found] : mesh_repairs(loaded)) {
+    repairs.push_back({{"mesh", file}, {"parts", found.second}, {"message", found.first}});
+  }
   nlohmann::json not_closed = nlohmann::json::array();
   for (const auto p : check.not_closed) not_closed.push_back(product.parts()[p].name);
   return {{"schema", "agile-cell/product"},
@@ -50,10 +73,12 @@ nlohmann::json product_json(const twin::Product& product, const twin::Interferen
           {"parts", parts},
           {"connections", connections},
           {"interferences", interferences},
-          {"meshes_not_closed", not_closed}};
+          {"meshes_not_closed", not_closed},
+          {"mesh_repairs", repairs}};
 }
 
-void print_product_table(const twin::Product& product, const twin::InterferenceCheck& check, std::ostream& out) {
+void print_product_table(const twin::LoadedProduct& loaded, const twin::InterferenceCheck& check, std::ostream& out) {
+  const twin::Product& product = loaded.product;
   out << "Product '" << product.name() << "' from " << product.source().string() << ": "
       << product.parts().size() << " parts, " << product.connections().size() << " links\n\n";
   TextTable parts({"#", "part", "type", "color", "x mm", "y mm", "z mm", "rx deg", "ry deg", "rz deg", "mesh"});
@@ -84,6 +109,11 @@ void print_product_table(const twin::Product& product, const twin::InterferenceC
                         twin::describe(product, i)});
     }
     overlaps.print(out);
+  }
+  for (const auto& [file, found] : mesh_repairs(loaded)) {
+    std::string parts;
+    for (const auto& name : found.second) parts += (parts.empty() ? "" : ", ") + name;
+    out << "note: mesh " << file << " (" << parts << "): " << found.first << '\n';
   }
   for (const auto p : check.not_closed) {
     out << "note: the mesh of " << product.parts()[p].name

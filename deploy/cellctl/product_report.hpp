@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "twin/geometry/product_loader.hpp"
 #include "twin/model/product.hpp"
 #include "twin/planning/interference.hpp"
 
@@ -12,8 +13,9 @@ namespace cellctl {
 
 // Schema "agile-cell/product" version 1, documented in docs/cli.md. With the finished
 // product's interference check: the parts that overlap, and those whose mesh is not closed.
-nlohmann::json product_json(const twin::Product& product, const twin::InterferenceCheck& check);
-void print_product_table(const twin::Product& product, const twin::InterferenceCheck& check, std::ostream& out);
+// And what loading repaired or found wrong in each mesh (`meshes`).
+nlohmann::json product_json(const twin::LoadedProduct& loaded, const twin::InterferenceCheck& check);
+void print_product_table(const twin::LoadedProduct& loaded, const twin::InterferenceCheck& check, std::ostream& out);
 
 // Extrinsic X, Y, Z angles in degrees (the orientation attribute's own convention).
 twin::Vec3 xyz_degrees(const twin::Quat& q);

@@ -2,7 +2,11 @@
 
 #include <LinearMath/btConvexHullComputer.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
+#include <set>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -34,7 +38,53 @@ void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
   for (unsigned c = 0; c < node.mNumChildren; ++c) append_node(scene, *node.mChildren[c], transform, out);
 }
 
+// Drops degenerate and duplicate triangles; counts open and non-manifold edges.
+void repair(TriangleMesh& mesh) {
+  using Corners = std::array<std::uint32_t, 3>;
+  std::set<Corners> seen;
+  std::vector<Corners> kept;
+  kept.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    const double scale = std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || (b - a).cross(c - a).squaredNorm() <= 1e-24 * scale * scale) {
+      ++mesh.repairs.degenerate;
+      continue;
+    }
+    Corners sorted = t;
+    std::sort(sorted.begin(), sorted.end());
+    if (!seen.insert(sorted).second) {
+      ++mesh.repairs.duplicate;
+      continue;
+    }
+    kept.push_back(t);
+  }
+  mesh.triangles = std::move(kept);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;  // undirected edge -> triangles
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) ++edges[std::minmax(t[k], t[(k + 1) % 3])];
+  }
+  for (const auto& [edge, count] : edges) {
+    if (count == 1) ++mesh.repairs.open_edges;
+    if (count > 2) ++mesh.repairs.non_manifold_edges;
+  }
+}
+
 }  // namespace
+
+std::string TriangleMesh::Repairs::describe() const {
+  std::vector<std::string> said;
+  const auto say = [&](std::size_t n, const std::string& one, const std::string& many) {
+    if (n > 0) said.push_back(std::to_string(n) + " " + (n == 1 ? one : many));
+  };
+  say(degenerate, "degenerate triangle dropped", "degenerate triangles dropped");
+  say(duplicate, "duplicate triangle dropped", "duplicate triangles dropped");
+  say(open_edges, "open edge (the mesh is not closed)", "open edges (the mesh is not closed)");
+  say(non_manifold_edges, "edge shared by more than two triangles", "edges shared by more than two triangles");
+  std::string out;
+  for (const auto& s : said) out += (out.empty() ? "" : "; ") + s;
+  return out;
+}
 
 std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file, double scale) {
   Assimp::Importer importer;
@@ -53,6 +103,8 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   for (const auto& v : mesh->vertices) {
     if (!v.allFinite()) throw MeshError("mesh " + file.string() + " has a vertex that is not finite");
   }
+  repair(*mesh);
+  if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds only degenerate triangles");
   mesh->convex = is_convex(*mesh);
   return mesh;
 }

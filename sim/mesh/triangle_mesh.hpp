@@ -24,6 +24,15 @@ struct TriangleMesh {
   // One closed piece whose surface is its convex hull (a box, a pin): its hull is exact.
   // False for anything concave, open or inconsistently wound, which is the safe side.
   bool convex = false;
+
+  // What loading found and repaired (a CAD export is rarely clean). Degenerate triangles
+  // (a repeated corner, or no area) and duplicates (the same three corners) are dropped;
+  // edges with one triangle (open) or more than two (non-manifold) are counted.
+  struct Repairs {
+    std::size_t degenerate = 0, duplicate = 0, open_edges = 0, non_manifold_edges = 0;
+    bool any() const { return degenerate + duplicate + open_edges + non_manifold_edges > 0; }
+    std::string describe() const;  // "dropped 3 degenerate triangles; 12 open edges", or ""
+  } repairs;
 };
 
 // Whether the mesh is one closed convex piece: its volume is its hull's (to 0.1 %).

@@ -52,3 +52,17 @@ TEST_CASE("convexity: a box is convex, a frame of one piece and an open box are 
   CHECK_FALSE(sim::load_mesh(data("planning/lipped-box/meshes/wall_left.obj"))->convex);
   CHECK_FALSE(sim::load_mesh(products("cranfield/meshes/faceplate.obj"))->convex);  // many pieces
 }
+
+TEST_CASE("a careless export: degenerate and duplicate triangles are dropped, open edges counted, all said",
+          "[mesh][repairs]") {
+  const auto block = sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3);
+  CHECK(block->triangles.size() == 10);  // 12 written: a duplicate and a sliver dropped
+  CHECK(block->repairs.degenerate == 1);
+  CHECK(block->repairs.duplicate == 1);
+  CHECK(block->repairs.open_edges == 4);  // around the missing top
+  CHECK(block->repairs.non_manifold_edges == 0);
+  CHECK_FALSE(block->convex);  // open: no volume to compare
+  CHECK(block->repairs.describe() ==
+        "1 degenerate triangle dropped; 1 duplicate triangle dropped; 4 open edges (the mesh is not closed)");
+  CHECK_FALSE(sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3)->repairs.any());
+}

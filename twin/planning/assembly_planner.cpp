@@ -32,6 +32,7 @@ class Search {
   Plan run() {
     plan_.sequence_planner = sequence_.name();
     plan_.path_planner = path_.name();
+    report_meshes();
     // Overlaps in the finished product first: no path can resolve them.
     for (const Interference& i : find_interferences(product_, options_.collision).overlaps) {
       plan_.findings.push_back({"interference", describe(product_.product, i), {name(i.part2), name(i.part1)}});
@@ -176,6 +177,19 @@ class Search {
         const std::string why = why_not(p);
         plan_.findings.push_back({"infeasible", name(p) + ": " + why, parts});
       }
+    }
+  }
+
+  // What loading repaired or found wrong in each mesh file, once per file.
+  void report_meshes() {
+    std::map<const sim::TriangleMesh*, std::vector<std::string>> users;
+    for (PartIndex p = 0; p < product_.meshes.size(); ++p) {
+      if (product_.meshes[p] && product_.meshes[p]->repairs.any()) users[product_.meshes[p].get()].push_back(name(p));
+    }
+    for (const auto& [mesh, parts] : users) {
+      const auto& part = product_.product.parts()[*product_.product.find_part_by_name(parts.front())];
+      plan_.findings.push_back({"mesh", part.mesh->file.filename().string() + " (" + join(parts) + "): " +
+                                            mesh->repairs.describe(), parts});
     }
   }
 
