@@ -36,9 +36,9 @@ struct Solid {
   double orientation = 1;          // -1: its faces are wound inwards
   std::vector<Vec3> samples;
 
-  // Whether a point `distance` from the surface lies inside. Where the nearest surface point
-  // is inside a face, the face's normal tells (for a closed, consistently wound mesh);
-  // at an edge or a corner, a ray does (slower).
+  // Whether a point lies inside. Where its nearest surface point is inside a face, the face's
+  // normal tells (the mesh is closed and consistently wound: Surface_mesh accepted every
+  // face); at an edge or a corner, a ray does (slower).
   bool contains(const Point& p) const {
     const auto [nearest, face] = surface->closest_point_and_primitive(p);
     const auto h = mesh.halfedge(face);
