@@ -55,7 +55,7 @@ struct MovingBody::Impl {
   static std::unique_ptr<btCollisionShape> clone(const btCollisionShape& shape) {
     if (shape.getShapeType() == BOX_SHAPE_PROXYTYPE) {
       const auto& box = static_cast<const btBoxShape&>(shape);
-      auto copy = std::make_unique<btBoxShape>(box.getHalfExtentsWithoutMargin());
+      auto copy = std::make_unique<btBoxShape>(box.getHalfExtentsWithMargin());  // it takes the margin off itself
       copy->setMargin(box.getMargin());
       return copy;
     }

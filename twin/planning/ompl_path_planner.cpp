@@ -122,9 +122,16 @@ std::optional<Trajectory> OmplPathPlanner::sample_path(const AssemblyScene& scen
   });
 
   og::SimpleSetup setup(space);
+  std::size_t checks = 0;
   setup.setStateValidityChecker([&](const ob::State* state) {
+    ++checks;
     return !scene.collision_at(held.with_arm, to_pose(state), "sample");
   });
+  const auto budget = [&] {
+    checks = 0;
+    return ob::plannerOrTerminationCondition(ob::PlannerTerminationCondition([&] { return checks >= options_.max_checks; }),
+                                             ob::timedPlannerTerminationCondition(options_.seconds));
+  };
   // Motions are checked at about 1 mm.
   setup.getSpaceInformation()->setStateValidityCheckingResolution(
       std::min(1.0, scene.world().options().linear_step / space->getMaximumExtent()));
@@ -133,8 +140,8 @@ std::optional<Trajectory> OmplPathPlanner::sample_path(const AssemblyScene& scen
   set_state(to, goal);
   setup.setStartAndGoalStates(from, to);
   setup.setPlanner(std::make_shared<og::RRTConnect>(setup.getSpaceInformation()));
-  if (setup.solve(options_.seconds) != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
-  setup.simplifySolution(options_.seconds);
+  if (setup.solve(budget()) != ob::PlannerStatus::EXACT_SOLUTION) return std::nullopt;
+  setup.simplifySolution(budget());
 
   Trajectory t;
   t.label = "ompl";

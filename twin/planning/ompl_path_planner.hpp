@@ -8,7 +8,11 @@
 namespace twin {
 
 struct OmplOptions {
-  double seconds = 0.5;           // per sampling run (one per gripper face)
+  // Each sampling run (one per gripper face) ends after this many collision checks: effort,
+  // not seconds, so that a busy machine plans as far as an idle one (a 0.5 s budget failed
+  // on a loaded machine). `seconds` is only the safety cap.
+  std::size_t max_checks = 100000;
+  double seconds = 30;
   double workspace_margin = 0.05; // m around the assembly that the part may use
   double retreat = 0.05;          // m the gripper backs away after release
   unsigned seed = 42;
