@@ -343,7 +343,14 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     // Before the cell is up: a submit that sees the cell's resources finds its state too.
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n' << fs::absolute(cell.state_folder()).string() << '\n';
     try {
-      wait_for_cell(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
+      // Until every resource is there. A process that dies meanwhile is restarted like any
+      // other (a young process can die in DDS discovery: a restarted robot did so under TSan,
+      // and this up gave the whole cell up).
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000));
+      while (!observer.wait_for_resources(cell.resource_ids(), 500ms).empty()) {
+        if (const std::string why = supervisor.tend(); !why.empty()) throw std::runtime_error(why);
+        if (std::chrono::steady_clock::now() > deadline) wait_for_cell(cell, observer, 0ms);  // throws naming the missing
+      }
     } catch (...) {
       fs::remove(pid_file(cell.domain));
       throw;
