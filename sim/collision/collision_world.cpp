@@ -49,8 +49,16 @@ struct MovingBody::Impl {
   bool has_exact = false;
 
   void add(const std::string& member, std::unique_ptr<btCollisionShape> shape, const Pose& offset) {
-    exact.add(member, clone(*shape), to_bullet(offset));
+    if (has_exact) exact.add(member, clone(*shape), to_bullet(offset));
     coarse.add(member, std::move(shape), to_bullet(offset));
+  }
+  // The exact body is made only once a concave member comes: until then it is the coarse one.
+  void begin_exact() {
+    if (has_exact) return;
+    for (std::size_t i = 0; i < coarse.shapes.size(); ++i) {
+      exact.add(coarse.member_of_child[i], clone(*coarse.shapes[i]), coarse.compound.getChildTransform(static_cast<int>(i)));
+    }
+    has_exact = true;
   }
   static std::unique_ptr<btCollisionShape> clone(const btCollisionShape& shape) {
     if (shape.getShapeType() == BOX_SHAPE_PROXYTYPE) {
@@ -87,6 +95,7 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
     }
     // One piece, maybe concave (a bracket, a housing with a bore): its hull is only the
     // coarse test; the exact one goes by its triangles.
+    impl_->begin_exact();
     impl_->coarse.add(member, std::move(hull), to_bullet(offset));
     for (const auto& t : mesh.triangles) {
       auto triangle = std::make_unique<btTriangleShape>(to_bullet(mesh.vertices[t[0]]), to_bullet(mesh.vertices[t[1]]),
@@ -94,7 +103,6 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
       triangle->setMargin(margin * kUnitsPerMetre);
       impl_->exact.add(member, std::move(triangle), to_bullet(offset));
     }
-    impl_->has_exact = true;
   }
 }
 
