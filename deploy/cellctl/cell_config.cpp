@@ -48,6 +48,15 @@ void add_point(std::vector<std::string>& argv, const char* option, const Point& 
   for (double v : p) argv.push_back(std::to_string(v));
 }
 
+// --gripper-finger-length M, ...: as services/dds/cli_options.hpp reads them.
+void add_gripper(std::vector<std::string>& argv, const fb::GripperGeometry& gripper) {
+  for (const auto& [name, size] : fb::gripper_sizes()) {
+    std::string flag = "--gripper-" + name;
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    argv.insert(argv.end(), {flag, std::to_string(gripper.*size)});
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> CellConfig::resource_ids() const {
@@ -163,7 +172,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds", "restart", "state_dir"});
+              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -191,6 +200,13 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, root, "state_dir", dir);
     if (dir.empty()) throw ConfigError(where(file, root["state_dir"]) + ": state_dir names a folder");
     c.state_dir = file.parent_path() / dir;
+  }
+  if (const YAML::Node gripper = root["gripper"]) {
+    std::set<std::string> names;
+    for (const auto& [name, size] : fb::gripper_sizes()) names.insert(name);
+    known_keys(file, gripper, names);
+    for (const auto& [name, size] : fb::gripper_sizes()) read(file, gripper, name.c_str(), c.gripper.*size);
+    if (const std::string problem = c.gripper.problem(); !problem.empty()) throw ConfigError(where(file, gripper) + ": " + problem);
   }
   if (const YAML::Node restart = root["restart"]) {
     known_keys(file, restart, {"limit", "window"});
@@ -242,6 +258,7 @@ std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::p
                                 std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--quiet"};
   if (!state_dir.empty()) argv.insert(argv.end(), {"--state-dir", state_dir.string()});
   if (!c.localhost_only) argv.push_back("--all-interfaces");
+  add_gripper(argv, c.gripper);
   return argv;
 }
 
@@ -266,6 +283,7 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     add_point(station.argv, "--dock", st.dock);
     add_point(station.argv, "--table", st.table);
     add_bounds(station.argv);
+    add_gripper(station.argv, c.gripper);
     out.push_back(station);
   }
   for (const auto& r : c.robots) {

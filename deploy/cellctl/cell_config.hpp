@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "services/node/gripper.hpp"
+
 namespace cellctl {
 
 using Point = std::array<double, 3>;
@@ -54,6 +56,9 @@ struct CellConfig {
   // `bounds: {min: [x, y, z], max: [x, y, z]}`, or the layout's box with a margin.
   Point bounds_min{}, bounds_max{};
   RestartPolicy restart;
+  // `gripper: {max_opening: 0.2, ...}`: the arms' gripper, one for the cell (a twin plans
+  // with it before it knows which station it gets); services/node/gripper.hpp.
+  fb::GripperGeometry gripper;
   // `state_dir:` the folder of the cell's database (relative to the file's folder); empty:
   // $XDG_STATE_HOME (or ~/.local/state)/agile-cell/domain-N.
   std::filesystem::path state_dir;

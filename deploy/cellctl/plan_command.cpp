@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/plan_report.hpp"
 #include "twin/report/plan_json.hpp"
 #include "twin/geometry/product_loader.hpp"
@@ -17,6 +18,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string path = "linear";
     std::string json;
     std::string gltf;
+    std::string cell;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("plan", "Plan and validate the assembly by virtual assembly");
@@ -25,13 +27,16 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--path", options->path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   cmd->add_option("--json", options->json, "Write the plan as JSON to this file");
   cmd->add_option("--gltf", options->gltf, "Write the virtual assembly as a glTF 2.0 animation (.gltf)");
+  cmd->add_option("--cell", options->cell, "Plan with this cell's gripper (its deployment file, key gripper:)");
   cmd->callback([options, &exit_code] {
+    twin::PlannerOptions planning;
+    if (!options->cell.empty()) planning.gripper = read_cell_config(options->cell).gripper;
     sim::MeshCache meshes;
     const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
     twin::require_geometry(loaded);
     auto sequence = twin::make_sequence_planner(options->sequence);
     auto path = twin::make_path_planner(options->path);
-    const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path);
+    const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, planning);
     print_plan(loaded.product, plan, std::cout);
     if (!options->json.empty()) {
       std::ofstream out(options->json);
@@ -40,7 +45,9 @@ void add_plan_command(CLI::App& app, int& exit_code) {
       std::cout << "\nwrote " << options->json << '\n';
     }
     if (!options->gltf.empty()) {
-      twin::write_gltf_animation(loaded, plan, options->gltf);
+      twin::AnimationOptions look;
+      look.gripper = planning.gripper;
+      twin::write_gltf_animation(loaded, plan, options->gltf, look);
       std::cout << (options->json.empty() ? "\n" : "") << "wrote " << options->gltf << '\n';
     }
     exit_code = plan.complete ? 0 : 1;

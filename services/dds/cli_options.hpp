@@ -4,7 +4,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+
 #include "services/blocks/sample_checks.hpp"
+#include "services/node/gripper.hpp"
 #include "services/dds/participant.hpp"
 
 namespace dds {
@@ -25,6 +28,16 @@ inline void add_bounds_option(CLI::App& app, std::vector<double>& values) {
 // --state-dir DIR: the folder of the cell's durable state (docs/durable-state.md).
 inline void add_state_option(CLI::App& app, std::string& state_dir) {
   app.add_option("--state-dir", state_dir, "Folder of the cell's database (default: state kept in memory only)");
+}
+
+// --gripper-finger-length M, ...: the arm's gripper (deployment key `gripper:`).
+inline void add_gripper_options(CLI::App& app, fb::GripperGeometry& gripper) {
+  for (const auto& [name, size] : fb::gripper_sizes()) {
+    std::string flag = "--gripper-" + name;
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    app.add_option(flag, gripper.*size, "The gripper's " + name + ", m (services/node/gripper.hpp)")
+        ->check(CLI::PositiveNumber);
+  }
 }
 
 inline fb::CellBounds apply_bounds(const std::vector<double>& values) {

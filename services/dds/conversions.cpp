@@ -132,8 +132,7 @@ fb::Data to_data(const cell::Command& c) {
           {"award", c.award().to_string()},
           {"source_award", c.source_award().to_string()},
           {"path", to_numbers(c.path())},
-          {"size", to_numbers(c.size())},
-          {"direction", to_numbers(c.direction())},
+          {"opening", c.opening()},
           {"sim_time", c.sim_time()}};
 }
 
@@ -150,8 +149,7 @@ cell::Command to_command(const fb::Data& d) {
   c.award(id(d, "award"));
   c.source_award(id(d, "source_award"));
   c.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
-  c.size(to_vec3(fb::get_or<fb::Numbers>(d, "size", {0, 0, 0})));
-  c.direction(to_vec3(fb::get_or<fb::Numbers>(d, "direction", {0, 0, 0})));
+  c.opening(fb::get_or<double>(d, "opening", 0));
   c.sim_time(fb::get_or<double>(d, "sim_time", 0));
   return c;
 }

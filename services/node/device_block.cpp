@@ -22,7 +22,7 @@ std::string DeviceBlock::problem_with(const Data& command) const {
   SampleCheck c(command, bounds_);
   c.text("command_id", true).text("resource_id", true).text("order_id").text("operation", true).text("part");
   c.text("part_type").text("source").text("destination").text("award").text("source_award");
-  c.poses("path", 0).vector("size").vector("direction").at_least("sim_time", 0);
+  c.poses("path", 0).finite("opening").at_least("sim_time", 0);
   if (c.ok()) check(command, c);
   if (!c.ok()) return c.error();
   return authorize_ ? authorize_(command) : "";

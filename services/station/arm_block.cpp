@@ -1,5 +1,7 @@
 #include "services/station/arm_block.hpp"
 
+#include <sstream>
+
 #include "services/state/cell_store.hpp"
 
 namespace fb {
@@ -17,22 +19,20 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
     return get<std::string>(d, "request_id").rfind(resource_id() + "/sim/", 0) == 0;
   };
 
-  const auto is_grasp = [](const Data& d) {
-    return get<Numbers>(d, "path").size() == 7 && get<Numbers>(d, "size").size() == 3 &&
-           get<Numbers>(d, "direction").size() == 3;
-  };
+  const auto is_grasp = [](const Data& d) { return get<Numbers>(d, "path").size() == 7; };
   transition("READY", "START", "WAITING", [this](const Data& d) { grip(d); },
              [op, is_grasp](const Data& d) { return op("grip")(d) && is_grasp(d); });
   transition("READY", "START", "READY", [this](const Data&) {
-    emit("FAIL", {{"reason", std::string("grip needs one pad pose, a pad size and a push direction")}});
+    emit("FAIL", {{"reason", std::string("grip needs one gripper pose and an opening")}});
   }, op("grip"));
   for (const char* motion : {"translate", "rotate"}) {
     transition("READY", "START", "MOVING", [this](const Data& d) {
       sim_.act_for(get_or<std::string>(d, "order_id", ""));
-      std::vector<std::string> carried{carriage()};
+      std::vector<std::string> carried = gripper_bodies();
+      carried.erase(carried.begin());  // the palm leads
       if (!held_.empty()) carried.push_back(held_);
       awaited_ = 1;
-      request(sim_.move(pad(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
+      request(sim_.move(gripper_bodies().front(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
     }, op(motion));
   }
   transition("READY", "START", "READY", [this](const Data&) {
@@ -71,13 +71,15 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
   }, mine);
 }
 
-// A grip is one pad pose with a size above 0 and a push direction; a motion, a path.
+// A grip is one gripper pose and an opening the gripper has; a motion, a path.
 void ArmBlock::check(const Data& command, SampleCheck& c) const {
   const std::string& operation = get<std::string>(command, "operation");
   if (operation == "grip") {
-    c.poses("path", 1, 1).vector("size", true).vector("direction");
-    const Numbers& push = get_or<Numbers>(command, "direction", {});
-    c.require(push.size() != 3 || push[0] != 0 || push[1] != 0 || push[2] != 0, "direction: (0, 0, 0) is no direction");
+    c.poses("path", 1, 1).at_least("opening", 0);
+    const double opening = get_or<double>(command, "opening", 0);
+    std::ostringstream why;
+    why << "opening: " << opening << " m is wider than the gripper opens (" << settings_.gripper.max_opening << " m)";
+    c.require(!(opening > settings_.gripper.max_opening), why.str());
   } else if (operation == "translate" || operation == "rotate") {
     c.poses("path", 1);
   } else if (operation == "connect" || operation == "disconnect") {
@@ -90,22 +92,28 @@ void ArmBlock::request(Data data) { emit("SIM", std::move(data)); }
 void ArmBlock::grip(const Data& d) {
   error_.clear();
   sim_.act_for("");  // the gripper is the arm's own
-  const Numbers& pose = get<Numbers>(d, "path");
-  const Carriage carriage_body = carriage_behind(pose, get<Numbers>(d, "size"), get<Numbers>(d, "direction"), settings_.gripper);
-  awaited_ = 2;
+  const Eigen::Isometry3d pose = numbers_pose(get<Numbers>(d, "path"));
+  const auto boxes = gripper_boxes(settings_.gripper, get_or<double>(d, "opening", 0));
+  awaited_ = static_cast<int>(boxes.size() * (has_gripper_ ? 2 : 1));
   if (has_gripper_) {
-    awaited_ += 2;
-    request(sim_.remove(pad()));
-    request(sim_.remove(carriage()));
+    for (const auto& body : gripper_bodies()) request(sim_.remove(body));
   }
-  request(sim_.spawn(pad(), pose, get<Numbers>(d, "size"), false));
-  request(sim_.spawn(carriage(), carriage_body.pose, carriage_body.half_extents, false));
+  for (const auto& box : boxes) {
+    const Eigen::Vector3d& h = box.half_extents;
+    request(sim_.spawn(resource_id() + "/" + box.name, pose_numbers(pose * box.pose), {h.x(), h.y(), h.z()}, false));
+  }
   has_gripper_ = true;
   held_ = get<std::string>(d, "part");
   held_order_ = get_or<std::string>(d, "order_id", "");
   // In the gripper from the moment the grip begins: a part half gripped when the arm's
   // process ends is one for inspection.
   if (store() && !held_.empty()) store()->grip(held_order_, held_, resource_id());
+}
+
+std::vector<std::string> ArmBlock::gripper_bodies() const {
+  std::vector<std::string> out;
+  for (const auto& box : gripper_boxes(settings_.gripper, 0)) out.push_back(resource_id() + "/" + box.name);
+  return out;
 }
 
 std::string ArmBlock::recover() {

@@ -1,12 +1,13 @@
 #pragma once
-// The station's robot arm: a gripper pad on a carriage, moved in cell-sim. It knows no
-// products: a part is a body id, a grasp is the pad's pose and size given by the command.
+// The station's robot arm: a two-finger parallel gripper on a carriage, moved in cell-sim. It
+// knows no products: a part is a body id, a grasp is the gripper's pose and opening given by
+// the command.
 //
-//   START grip (part, path = [pad pose], size = pad half extents, direction = push):
-//         the pad and its carriage (behind the pad, against the push) go to the grasp; the
-//         part is held from now on
-//   START translate | rotate (path): the pad moves along the path with the carriage and the
-//         held part; a collision ends it (FAIL with the contact)
+//   START grip (part, path = [gripper pose], opening = m between the fingers): the gripper
+//         (palm, fingers, carriage; services/node/gripper.hpp) goes to the grasp; the part is
+//         held from now on
+//   START translate | rotate (path): the palm moves along the path with the fingers, the
+//         carriage and the held part; a collision ends it (FAIL with the contact)
 //   START release: lets go;  connect | disconnect (part): the part becomes an obstacle
 //         (joined to the assembly) or movable again
 //   SIM_REPLY: cell-sim's answers; SIM: requests to cell-sim
@@ -20,7 +21,7 @@ namespace fb {
 struct ArmSettings {
   double speed = 0.25;          // m/s
   double angular_speed = 1.0;   // rad/s
-  GripperSize gripper;
+  GripperGeometry gripper;
 };
 
 class ArmBlock : public DeviceBlock {
@@ -33,8 +34,8 @@ class ArmBlock : public DeviceBlock {
   std::string recover() override;
   void check(const Data& command, SampleCheck& check) const override;
   void grip(const Data& command);
-  std::string pad() const { return resource_id() + "/pad"; }
-  std::string carriage() const { return resource_id() + "/carriage"; }
+  // Its bodies in cell-sim, the palm first.
+  std::vector<std::string> gripper_bodies() const;
   void request(Data data);
 
   ArmSettings settings_;

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   app.add_option("--table", table, "Half extents of the table, m");
   app.add_option("--arm-speed", arm_settings.speed, "m/s")->check(CLI::PositiveNumber);
   app.add_option("--arm-angular-speed", arm_settings.angular_speed, "rad/s")->check(CLI::PositiveNumber);
+  dds::add_gripper_options(app, arm_settings.gripper);
   app.add_option("--lease", station.liveliness_lease_s, "Liveliness lease of the capabilities, s");
   dds::add_state_option(app, station.state_dir);
   CLI11_PARSE(app, argc, argv);

@@ -260,7 +260,7 @@ cell::CommandState final_state(HostileCell& cell, const std::string& id) {
   return events.back().state();
 }
 
-// The intruder hires arm-1 as a twin would, and grips: the arm holds a pad at the station.
+// The intruder hires arm-1 as a twin would, and grips: the arm's gripper stands at the station.
 std::string hire_arm_and_grip(HostileCell& cell) {
   std::string why;
   const std::string award = test::hire(cell.intruder(), "arm-1", "rogue", "translate", {"station-1", "", 0}, &why);
@@ -268,8 +268,7 @@ std::string hire_arm_and_grip(HostileCell& cell) {
   REQUIRE(award == "rogue/translate/arm-1");
   cell::Command grip = command("rogue/grip", "arm-1", "rogue", "grip", award);  // closing on nothing
   grip.path({pose(0, 0.3, 0)});
-  grip.size(dds::vec3(0.01, 0.01, 0.01));
-  grip.direction(dds::vec3(0, -1, 0));
+  grip.opening(0.02);
   REQUIRE(cell.send(grip));
   REQUIRE(final_state(cell, "rogue/grip") == cell::SUCCEEDED);
   return award;
@@ -322,17 +321,16 @@ TEST_CASE("hostile: a translate to x = +inf is rejected", "[process][hostile]") 
   bad_pose_is_rejected(212, "infinite", pose(HUGE_VAL, 0.3, 0), "path[0]: position (inf, 0.3, 0) is not finite");
 }
 
-TEST_CASE("hostile: a grip of negative or NaN size is rejected", "[process][hostile]") {
-  HostileCell cell(213, "bad-size");
+TEST_CASE("hostile: a grip of negative, NaN or too wide an opening is rejected", "[process][hostile]") {
+  HostileCell cell(213, "bad-opening");
   const std::string award = hire_arm_and_grip(cell);
-  for (const cell::Vec3& size : {dds::vec3(-0.01, 0.01, 0.01), dds::vec3(std::nan(""), 0.01, 0.01)}) {
-    cell::Command grip = command("rogue/grip-" + std::to_string(size.x()), "arm-1", "rogue", "grip", award);
+  for (const double opening : {-0.01, std::nan(""), 5.0}) {
+    cell::Command grip = command("rogue/grip-" + std::to_string(opening), "arm-1", "rogue", "grip", award);
     grip.part("rogue/nothing");
     grip.path({pose(0, 0.3, 0)});
-    grip.size(size);
-    grip.direction(dds::vec3(0, -1, 0));
+    grip.opening(opening);
     REQUIRE(cell.send(grip));
-    CHECK(rejection(cell, grip.command_id().to_string()).find("size: (") == 0);
+    CHECK(rejection(cell, grip.command_id().to_string()).find("opening: ") == 0);
   }
   release_arm(cell);
   CHECK(cell.order_succeeds("ok1"));

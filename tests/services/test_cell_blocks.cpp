@@ -35,15 +35,18 @@ fb::Data reply_to(const fb::Event& request, fb::Data extra = {}) {
 
 }  // namespace
 
-TEST_CASE("arm: a grip places pad and carriage, a second grip replaces them", "[fb][arm]") {
+TEST_CASE("arm: a grip places palm, fingers and carriage, a second grip replaces them", "[fb][arm]") {
   fb::BlockTestFixture<fb::ArmBlock> f("arm", "arm-1", fb::ArmSettings{});
-  const fb::Data grasp{{"part", std::string("o1/B1")}, {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}},
-                       {"size", fb::Numbers{0.01, 0.005, 0.01}}, {"direction", fb::Numbers{0, -1, 0}}};
+  const fb::Data grasp{{"part", std::string("o1/B1")}, {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
   for (int round = 0; round < 2; ++round) {
     const std::string id = "g" + std::to_string(round);
     CHECK(names<fb::ArmBlock>(f.send("COMMAND", command(id, "grip", grasp))) == Names{"ACCEPT"});
     const auto requests = f.send("START", {{"command_id", id}});
-    REQUIRE(requests.size() == (round == 0 ? 2u : 4u));
+    REQUIRE(requests.size() == (round == 0 ? 4u : 8u));
+    // The fingers stand 20 mm apart, on either side of the gripper's origin.
+    const auto& finger = requests[round == 0 ? 1 : 5].data;
+    CHECK(fb::get<std::string>(finger, "body_id") == "arm-1/finger-1");
+    CHECK(fb::get<fb::Numbers>(finger, "placement")[0] == Approx(-0.01 - fb::GripperGeometry{}.finger_thickness / 2));
     for (std::size_t i = 0; i + 1 < requests.size(); ++i) CHECK(f.send("SIM_REPLY", reply_to(requests[i])).empty());
     CHECK(names<fb::ArmBlock>(f.send("SIM_REPLY", reply_to(requests.back()))) == Names{"DONE"});
   }
@@ -143,8 +146,7 @@ TEST_CASE("device: work queued for an order that has ended fails at once", "[fb]
 namespace {
 
 const fb::Data kGrasp{{"part", std::string("o1/B1")}, {"order_id", std::string("o1")},
-                      {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"size", fb::Numbers{0.01, 0.005, 0.01}},
-                      {"direction", fb::Numbers{0, -1, 0}}};
+                      {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
 
 // The reason an arm refuses the command, "" if it accepts it.
 std::string arm_refusal(fb::BlockTestFixture<fb::ArmBlock>& f, const std::string& operation, fb::Data fields) {
@@ -187,10 +189,9 @@ TEST_CASE("device: a malformed command is refused with the field, never started"
   fb::Numbers long_path;
   for (int i = 0; i < 2049; ++i) long_path.insert(long_path.end(), {0, 0, 0, 1, 0, 0, 0});
   CHECK(arm_refusal(f, "translate", with(move, "path", long_path)) == "path: 2049 poses, not 0 to 2048");
-  CHECK(arm_refusal(f, "grip", with(kGrasp, "size", fb::Numbers{-0.01, 0.005, 0.01})) ==
-        "size: (-0.01, 0.005, 0.01) is not a size (each above 0)");
-  CHECK(arm_refusal(f, "grip", with(kGrasp, "size", fb::Numbers{nan, 0.005, 0.01})) == "size: (nan, 0.005, 0.01) is not finite");
-  CHECK(arm_refusal(f, "grip", with(kGrasp, "direction", fb::Numbers{0, 0, 0})) == "direction: (0, 0, 0) is no direction");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "opening", -0.01)) == "opening: -0.01 is below 0");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "opening", nan)) == "opening: nan is not finite");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "opening", 0.5)) == "opening: 0.5 m is wider than the gripper opens (0.2 m)");
   CHECK(arm_refusal(f, "grip", with(kGrasp, "part", std::string(300, 'x'))) == "part: 300 characters, more than 255");
   CHECK(arm_refusal(f, "grip", with(kGrasp, "sim_time", nan)) == "sim_time: nan is not finite");
   CHECK(f.block().refused() == 12);
@@ -238,7 +239,7 @@ TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "
                       {"fixture", true}, {"is_static", true}};
   CHECK(ask("station-1", "spawn", "table", table).empty());
   CHECK(ask("ok1", "spawn", "ok1/B1", box).empty());
-  CHECK(ask("arm-1", "spawn", "arm-1/pad", box).empty());
+  CHECK(ask("arm-1", "spawn", "arm-1/palm", box).empty());
   CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "half_extents", fb::Numbers{-1, 0.01, 0.01})) ==
         "half_extents: (-1, 0.01, 0.01) has a negative size");
   CHECK(ask("ok1", "spawn", "ok1/B2", with(box, "placement", fb::Numbers{0, 0.5, 0, 0, 0, 0, 0})) ==
@@ -264,11 +265,11 @@ TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "
   CHECK(ask("intruder", "move", "ok1/B1", move) == "ok1/B1 belongs to ok1, not to intruder");
   // The arm carries ok1's part only while ok1 has hired it.
   const fb::Data carry = with(with(move, "carried", std::string("ok1/B1")), "order_id", std::string("ok1"));
-  CHECK(ask("arm-1", "move", "arm-1/pad", carry) == "ok1/B1 belongs to order ok1, which has not hired arm-1");
+  CHECK(ask("arm-1", "move", "arm-1/palm", carry) == "ok1/B1 belongs to order ok1, which has not hired arm-1");
   f.send("HIRED", {{"resource_id", std::string("arm-1")}, {"order_id", std::string("ok1")}});
-  CHECK(ask("arm-1", "move", "arm-1/pad", carry).empty());
+  CHECK(ask("arm-1", "move", "arm-1/palm", carry).empty());
   CHECK(f.block().world().pose("ok1/B1")->translation().x() == Approx(0.1));
-  CHECK(ask("intruder", "move", "arm-1/pad", carry) == "arm-1/pad belongs to arm-1, not to intruder");
+  CHECK(ask("intruder", "move", "arm-1/palm", carry) == "arm-1/palm belongs to arm-1, not to intruder");
   f.send("ORDER_ENDED", {{"order_id", std::string("ok1")}});
   CHECK_FALSE(f.block().world().pose("ok1/B1"));
   CHECK(f.block().world().pose("table"));

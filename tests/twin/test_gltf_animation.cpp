@@ -28,7 +28,7 @@ TEST_CASE("the virtual assembly is written as a glTF 2.0 animation", "[gltf]") {
 
   CHECK(model.asset.version == "2.0");
   REQUIRE(model.scenes.size() == 1);
-  CHECK(model.scenes[0].nodes.size() == loaded.product.parts().size() + 1);  // parts + arm
+  CHECK(model.scenes[0].nodes.size() == loaded.product.parts().size() + plan.steps.size());  // parts + a gripper per step
   const auto find_node = [&](const std::string& name) {
     const auto it = std::find_if(model.nodes.begin(), model.nodes.end(), [&](const auto& n) { return n.name == name; });
     REQUIRE(it != model.nodes.end());
@@ -41,8 +41,13 @@ TEST_CASE("the virtual assembly is written as a glTF 2.0 animation", "[gltf]") {
 
   REQUIRE(model.animations.size() == 1);
   const auto& animation = model.animations[0];
-  // translation, rotation and scale for every part and for the arm
-  CHECK(animation.channels.size() == 3 * (loaded.product.parts().size() + 1));
+  // translation, rotation and scale for every part and every step's gripper
+  CHECK(animation.channels.size() == 3 * (loaded.product.parts().size() + plan.steps.size()));
+  // The front faceplate's gripper: its fingers 180 mm apart, on the plate's outer faces.
+  const auto& gripper = model.meshes[model.nodes[find_node("gripper (front)")].mesh];
+  const auto& corners = model.accessors[gripper.primitives[0].attributes.at("POSITION")];
+  const fb::GripperGeometry size;
+  CHECK(corners.maxValues[0] - corners.minValues[0] == Approx(0.180 + 2 * size.finger_thickness).margin(1e-6));
   // The front faceplate's translation track ends at its final place (78 mm up).
   const int front = find_node("front");
   for (const auto& channel : animation.channels) {

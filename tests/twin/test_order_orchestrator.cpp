@@ -54,6 +54,7 @@ struct Outcome {
   std::vector<std::string> spawned;   // bodies, in order
   std::vector<std::string> statuses;  // messages
   std::vector<std::string> order;     // what went out: "SIM spawn", "CFP host", ...
+  std::vector<Data> grips;            // the grip commands
   bool finished = false, complete = false;
   std::string error;
 };
@@ -122,6 +123,7 @@ Outcome run(Twin& t, const Cell& cell) {
                      {"depth", 0.001}, {"start_time", 0.0}, {"end_time", 1.0}, {"distance", 0.1}});
     } else if (e.name == "COMMAND") {
       out.order.push_back("COMMAND " + get<std::string>(e.data, "operation"));
+      if (get<std::string>(e.data, "operation") == "grip") out.grips.push_back(e.data);
       const std::string reason = cell.refuse(e.data);
       if (reason == kNoAnswer) continue;
       more = t.send("orchestrator", "COMMAND_EVENT", {{"command_id", e.data.at("command_id")},
@@ -182,6 +184,22 @@ TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holdin
   // The hired robot gets one fetch per part, the arm one grip per part.
   CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND fetch") == static_cast<long>(cranfield.plan.steps.size()));
   CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND grip") == static_cast<long>(cranfield.plan.steps.size()));
+  // Virtual and physical assembly hold each part by the planned grasp: the gripper's four
+  // bodies in cell-sim, the arm's grip as wide and turned as the plan's.
+  for (const char* body : {"o1/virtual/gripper-palm", "o1/virtual/gripper-finger-1", "o1/virtual/gripper-finger-2",
+                           "o1/virtual/gripper-carriage"}) {
+    CHECK(std::count(out.spawned.begin(), out.spawned.end(), body) == static_cast<long>(cranfield.plan.steps.size()));
+  }
+  REQUIRE(out.grips.size() == cranfield.plan.steps.size());
+  for (std::size_t k = 0; k < out.grips.size(); ++k) {
+    const twin::Trajectory& planned = cranfield.plan.steps[k].trajectory;
+    INFO("step " << k + 1 << ": " << planned.grasp.label);
+    CHECK(get<double>(out.grips[k], "opening") == Approx(planned.grasp.opening));
+    const fb::Numbers& pose = get<fb::Numbers>(out.grips[k], "path");
+    REQUIRE(pose.size() == 7);
+    const twin::Quat turned(pose[3], pose[4], pose[5], pose[6]);
+    CHECK(turned.angularDistance(twin::Quat(planned.waypoints.front().gripper.linear())) < 1e-9);
+  }
 }
 
 TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on when the station is its", "[twin][orchestration]") {

@@ -30,7 +30,7 @@ const std::string kHost = "host", kArm = "arm", kRobot = "robot", kGive = "give/
 
 OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& product, const Plan& plan,
                                      OrderSettings settings)
-    : BasicBlock(std::move(name), "IDLE"), product_(product), plan_(plan), scene_(product),
+    : BasicBlock(std::move(name), "IDLE"), product_(product), plan_(plan),
       settings_(std::move(settings)), sim_(settings_.order_id) {
   declare_input("START");
   declare_input("TICK");
@@ -173,7 +173,7 @@ void OrderOrchestrator::try_begin_virtual() {
   if (settings_.resume.attempt > 1) {
     // An earlier twin of the order may have died in the middle of it: its virtual bodies
     // are still in the order's scene (cell-sim keeps them for the order), in the way.
-    std::vector<std::string> left{settings_.order_id + "/virtual/gripper-pad", settings_.order_id + "/virtual/gripper-carriage"};
+    std::vector<std::string> left = virtual_gripper();
     for (PartIndex p = 0; p < product_.product.parts().size(); ++p) left.push_back(virtual_body(p));
     for (const auto& body : left) actions_.push_back({Action::sim, sim_.remove(body), false, true});
   }
@@ -335,8 +335,8 @@ Pose OrderOrchestrator::at(const std::string& station, const Pose& pose) const {
 Numbers OrderOrchestrator::pose_numbers(const std::vector<Pose>& poses) const {
   Numbers out;
   for (const Pose& p : poses) {
-    const Quat q(p.linear());
-    out.insert(out.end(), {p.translation().x(), p.translation().y(), p.translation().z(), q.w(), q.x(), q.y(), q.z()});
+    const Numbers seven = fb::pose_numbers(p);
+    out.insert(out.end(), seven.begin(), seven.end());
   }
   return out;
 }
@@ -361,31 +361,44 @@ Data OrderOrchestrator::command(const std::string& resource, const std::string& 
 void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   const PartIndex part = plan_.steps[step].part;
   const Trajectory t = candidates(step)[candidate];
-  const std::string body = virtual_body(part), pad = settings_.order_id + "/virtual/gripper-pad",
-                    carriage = settings_.order_id + "/virtual/gripper-carriage";
+  const std::string body = virtual_body(part);
+  const std::vector<std::string> gripper = virtual_gripper();
   const std::string& scene = settings_.order_id;
   const auto& w = t.waypoints;
   const MeshRef& mesh = *product_.product.parts()[part].mesh;
   actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at(virtual_station_, w.front().part)}), {0, 0, 0},
                                               false, mesh.file.string(), scene, mesh.scale)});
-  const Numbers grasp = pose_numbers({at(virtual_station_, w.front().gripper)});
-  const Vec3 half = scene_.pad_half_extents(part, t.grip_direction);
-  const Numbers pad_half{half.x(), half.y(), half.z()};
-  const fb::Carriage c = fb::carriage_behind(grasp, pad_half, {t.grip_direction.x(), t.grip_direction.y(),
-                                                               t.grip_direction.z()}, settings_.gripper);
-  actions_.push_back({Action::sim, sim_.spawn(pad, grasp, pad_half, false, "", scene)});
-  actions_.push_back({Action::sim, sim_.spawn(carriage, c.pose, c.half_extents, false, "", scene)});
-  spawned_.insert({body, pad, carriage});
+  const Pose grasp = at(virtual_station_, w.front().gripper);
+  const auto boxes = fb::gripper_boxes(settings_.gripper, t.grasp.opening);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const Vec3& h = boxes[i].half_extents;
+    actions_.push_back({Action::sim, sim_.spawn(gripper[i], fb::pose_numbers(grasp * boxes[i].pose), {h.x(), h.y(), h.z()},
+                                                false, "", scene)});
+  }
+  spawned_.insert(body);
+  spawned_.insert(gripper.begin(), gripper.end());
   std::vector<Pose> holding, retreat;
   for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
-  actions_.push_back({Action::sim, sim_.move(pad, {carriage, body}, pose_numbers(holding), v, omega), true});
-  if (!retreat.empty()) actions_.push_back({Action::sim, sim_.move(pad, {carriage}, pose_numbers(retreat), v, omega), true});
-  actions_.push_back({Action::sim, sim_.set_static(body, true)});
-  for (const auto& gripper : {pad, carriage}) {
-    actions_.push_back({Action::sim, sim_.remove(gripper)});
-    spawned_.erase(gripper);
+  // The palm leads; the fingers, the carriage and (while held) the part go with it.
+  std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
+  carried.push_back(body);
+  actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers(holding), v, omega), true});
+  carried.pop_back();
+  if (!retreat.empty()) {
+    actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers(retreat), v, omega), true});
   }
+  actions_.push_back({Action::sim, sim_.set_static(body, true)});
+  for (const auto& g : gripper) {
+    actions_.push_back({Action::sim, sim_.remove(g)});
+    spawned_.erase(g);
+  }
+}
+
+std::vector<std::string> OrderOrchestrator::virtual_gripper() const {
+  std::vector<std::string> out;
+  for (const auto& box : fb::gripper_boxes(settings_.gripper, 0)) out.push_back(settings_.order_id + "/virtual/gripper-" + box.name);
+  return out;
 }
 
 void OrderOrchestrator::on_collision(const std::string& reason) {
@@ -397,8 +410,9 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
                    {"part", name}});
   actions_.clear();
   action_running_ = false;
-  for (const auto& body : {virtual_body(part), settings_.order_id + "/virtual/gripper-pad",
-                           settings_.order_id + "/virtual/gripper-carriage"}) {
+  std::vector<std::string> left = virtual_gripper();
+  left.push_back(virtual_body(part));
+  for (const auto& body : left) {
     actions_.push_back({Action::sim, sim_.remove(body)});
     spawned_.erase(body);
   }
@@ -413,6 +427,7 @@ void OrderOrchestrator::back_to_sequence_planning() {
   barred_.erase(barred_.upper_bound(step_), barred_.end());
   barred_[step_].insert(part);
   PlannerOptions options;
+  options.gripper = settings_.gripper;
   options.given.assign(plan_.steps.begin(), plan_.steps.begin() + step_);  // validated already
   options.not_next = barred_[step_];
   SearchSequencePlanner sequence;
@@ -542,9 +557,7 @@ void OrderOrchestrator::plan_physical() {
                                    with_translation(start, start.translation().x(), safe, start.translation().z()), start};
     Data take = command(arm_, "grip", body);
     take["path"] = pose_numbers({delivered * grip});
-    const Vec3 pad = scene_.pad_half_extents(part, t.grip_direction);
-    take["size"] = Numbers{pad.x(), pad.y(), pad.z()};
-    take["direction"] = Numbers{t.grip_direction.x(), t.grip_direction.y(), t.grip_direction.z()};
+    take["opening"] = t.grasp.opening;
     actions_.push_back({Action::command, take});
     std::vector<Pose> holding, retreat;
     for (const Pose& p : part_path) holding.push_back(p * grip);

@@ -7,7 +7,7 @@
 //   VIRTUAL      virtual assembly in cell-sim, in the order's own virtual scene (it meets
 //                the cell's fixtures and nothing of other orders, so many orders do this at
 //                once and hold no resource): each part spawned where its trajectory starts,
-//                a gripper pad and carriage spawned at the grasp, moved, the gripper backs
+//                the arm's gripper spawned at the planned grasp, moved, the gripper backs
 //                out, the part becomes static. A collision is answered with the next
 //                trajectory the planner had for that part; none left: back to sequence
 //                planning from the parts assembled so far, with that part barred from coming
@@ -65,7 +65,7 @@ struct OrderSettings {
   std::chrono::milliseconds resend_after{2000};
   double arm_speed = 0.25;          // m/s: virtual assembly's moves, until an arm's capability says
   double arm_angular_speed = 1.0;   // rad/s
-  fb::GripperSize gripper;
+  fb::GripperGeometry gripper;     // the cell's (deployment key `gripper:`), as the plan used it
   // Taking up an order whose earlier twin ended during physical assembly, as the cell's
   // state left it: the order books the station its parts stand on, and its steps done are
   // not done again.
@@ -141,13 +141,13 @@ class OrderOrchestrator : public fb::BasicBlock {
   Pose at(const std::string& station, const Pose& pose) const;
   fb::Numbers pose_numbers(const std::vector<Pose>& poses) const;
   std::string virtual_body(PartIndex part) const;
+  std::vector<std::string> virtual_gripper() const;  // its bodies in the order's scene, the palm first
   std::string physical_body(PartIndex part) const;
   std::map<std::string, int> parts_per_type() const;
   bool waited_too_long() const;
 
   const LoadedProduct& product_;
   Plan plan_;
-  AssemblyScene scene_;  // for the gripper's pad size per part and push
   OrderSettings settings_;
   fb::SimRequests sim_;
   std::map<std::string, Place> places_;  // what capabilities say, by resource id

@@ -55,6 +55,7 @@ struct Options {
   dds::ParticipantSettings dds;
   std::string order, product, out = ".", sequence = "search", path = "linear", state_dir;
   double wait_s = 30, lease_s = 5;
+  fb::GripperGeometry gripper;
   bool verbose = false;
   bool quiet = false;
 };
@@ -116,7 +117,9 @@ class TwinProcess {
     status("PLANNING", "planning " + std::to_string(product.product.parts().size()) + " parts", 0);
     auto sequence = twin::make_sequence_planner(options_.sequence);
     auto path = twin::make_path_planner(options_.path);
-    twin::Plan plan = twin::plan_assembly(product, *sequence, *path);
+    twin::PlannerOptions planning;
+    planning.gripper = options_.gripper;
+    twin::Plan plan = twin::plan_assembly(product, *sequence, *path, planning);
     std::filesystem::create_directories(options_.out);
     const auto plan_file = std::filesystem::absolute(options_.out) / "plan.json";
     if (!plan.complete) {
@@ -220,6 +223,7 @@ class TwinProcess {
     settings.resume = resume_;
     settings.take_up_after_restart = store_ && store_->awaits_twin(options_.order);
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
+    settings.gripper = options_.gripper;
     fb::NegotiationSettings negotiation;
     negotiation.wait = settings.wait_timeout;
     auto& orchestrator = twin::add_order_network(r, product, plan, settings, negotiation);
@@ -331,7 +335,9 @@ class TwinProcess {
     validated.findings.insert(validated.findings.end(), findings.begin(), findings.end());
     write_plan(product, validated, plan_file);
     const auto animation = plan_file.parent_path() / "animation.gltf";
-    twin::write_gltf_animation(product, validated, animation);
+    twin::AnimationOptions look;
+    look.gripper = options_.gripper;
+    twin::write_gltf_animation(product, validated, animation, look);
     if (!orchestrator.error().empty()) return end_with(1, orchestrator.error(), plan_file.string(), true);
     result(true, plan_file.string(), animation.string(), "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);
@@ -365,6 +371,7 @@ int main(int argc, char** argv) {
   app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);
   app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
   dds::add_state_option(app, o.state_dir);
+  dds::add_gripper_options(app, o.gripper);
   app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
   app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
   CLI11_PARSE(app, argc, argv);

@@ -27,7 +27,7 @@ class Search {
  public:
   Search(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path, const PlannerOptions& options)
       : product_(product), sequence_(sequence), path_(path), options_(options),
-        scene_(product, options.collision, options.arm), assembled_(product.product.parts().size(), false) {}
+        scene_(product, options.collision, options.gripper), assembled_(product.product.parts().size(), false) {}
 
   Plan run() {
     plan_.sequence_planner = sequence_.name();
@@ -51,6 +51,7 @@ class Search {
 
  private:
   const std::string& name(PartIndex p) const { return product_.product.parts()[p].name; }
+  double final_bounds_min(PartIndex p) const { return scene_.final_bounds(p).sizes().minCoeff(); }
 
   // Depth-first: returns true once every part is in.
   bool extend() {
@@ -71,9 +72,11 @@ class Search {
       std::optional<Trajectory> trajectory;
       while ((trajectory = path_.next(scene_, part, tried))) {
         ++plan_.trajectories_simulated;
-        auto collision = scene_.simulate(part, *trajectory);
+        auto collision = scene_.simulate_grasps(part, *trajectory);
         if (!collision) break;
-        blocked_by_[part].insert(collision->with);
+        if (!collision->with.empty()) {
+          (collision->member == "part" ? blocked_by_ : gripper_blocked_by_)[part].insert(collision->with);
+        }
         if (!worst_.count(part) || collision->depth > worst_[part].depth) worst_[part] = *collision;
         tried.push_back({std::move(*trajectory), collision});
       }
@@ -124,11 +127,18 @@ class Search {
     if (unplaceable_.count(p)) {
       const auto& blockers = blocked_by_[p];
       std::vector<std::string> why;
-      if (const auto worst = worst_.find(p); worst != worst_.end()) {
+      if (const auto worst = worst_.find(p); worst != worst_.end() && worst->second.phase == "grasp") {
+        why.push_back("no grasp: it is " + millimetres(final_bounds_min(p)) + " across at its narrowest, " +
+                      millimetres(worst->second.depth) + " more than the gripper opens");
+      } else if (worst != worst_.end()) {
         const Collision& c = worst->second;
-        why.push_back("no collision-free path; blocked by " + join({blockers.begin(), blockers.end()}) +
-                      " (deepest: the " + c.member + " hit " + c.with + " " + millimetres(c.depth) + " deep while " +
-                      c.phase + ")");
+        const auto& gripper = gripper_blocked_by_[p];
+        std::string what = "no collision-free path; ";
+        if (!blockers.empty()) what += "blocked by " + join({blockers.begin(), blockers.end()});
+        if (!blockers.empty() && !gripper.empty()) what += "; where the part was free, ";
+        if (!gripper.empty()) what += "the gripper hit " + join({gripper.begin(), gripper.end()}) + " on every grasp";
+        why.push_back(what + " (deepest: the " + c.member + " hit " + c.with + " " + millimetres(c.depth) +
+                      " deep while " + c.phase + ")");
       }
       for (const Interference& i : interferences_) {
         const PartIndex other = i.part1 == p ? i.part2 : i.part2 == p ? i.part1 : p;
@@ -174,6 +184,7 @@ class Search {
         if (in[p]) continue;
         std::vector<std::string> parts = {name(p)};
         parts.insert(parts.end(), blocked_by_[p].begin(), blocked_by_[p].end());
+        parts.insert(parts.end(), gripper_blocked_by_[p].begin(), gripper_blocked_by_[p].end());
         const std::string why = why_not(p);
         plan_.findings.push_back({"infeasible", name(p) + ": " + why, parts});
       }
@@ -216,7 +227,8 @@ class Search {
   Plan plan_;
   std::vector<PlanStep> deepest_;
   std::unordered_set<std::vector<bool>> failed_states_;
-  std::map<PartIndex, std::set<std::string>> blocked_by_;
+  std::map<PartIndex, std::set<std::string>> blocked_by_;          // what the part itself hit
+  std::map<PartIndex, std::set<std::string>> gripper_blocked_by_;  // what the gripper hit, the part free
   std::set<PartIndex> unplaceable_;
   std::set<PartIndex> backtracked_;
   std::set<PartIndex> tried_;

@@ -45,7 +45,7 @@ struct PlannerOptions {
   std::vector<PlanStep> given;
   std::set<PartIndex> not_next;
   sim::CollisionOptions collision;
-  ArmGeometry arm;
+  fb::GripperGeometry gripper;
 };
 
 Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,

@@ -7,13 +7,6 @@ namespace {
 
 constexpr double kOnSurface = 1e-4;  // m: a part this close to y = 0 stands on the station
 
-// Index and sign of a direction's dominant axis.
-std::pair<int, double> dominant_axis(const Vec3& direction) {
-  int axis = 0;
-  direction.cwiseAbs().maxCoeff(&axis);
-  return {axis, direction[axis] > 0 ? 1.0 : -1.0};
-}
-
 Pose translation(const Vec3& t) {
   Pose p = Pose::Identity();
   p.translation() = t;
@@ -22,8 +15,8 @@ Pose translation(const Vec3& t) {
 
 }  // namespace
 
-AssemblyScene::AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options, ArmGeometry arm)
-    : product_(product), arm_(arm), world_(options) {
+AssemblyScene::AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options, fb::GripperGeometry gripper)
+    : product_(product), gripper_(gripper), world_(options) {
   const auto& parts = product.product.parts();
   for (PartIndex i = 0; i < parts.size(); ++i) {
     Eigen::AlignedBox3d box;
@@ -88,40 +81,19 @@ void AssemblyScene::update_frontier(PartIndex part) {
   }
 }
 
-Eigen::Vector3d AssemblyScene::pad_half_extents(PartIndex part, const Vec3& direction) const {
-  const int axis = dominant_axis(direction).first;
-  Eigen::Vector3d half = bounds_[part].sizes().cwiseMin(arm_.pad_max_width) / 2;
-  half[axis] = arm_.pad_thickness / 2;
-  return half;
+std::vector<Grasp> AssemblyScene::grasps(PartIndex part, const Vec3& direction) const {
+  return grasps_for(bounds_[part], product_.product.parts()[part].final_pose, direction, gripper_);
 }
 
-Pose AssemblyScene::grip_offset(PartIndex part, const Vec3& direction) const {
-  const auto [axis, sign] = dominant_axis(direction);
-  const Eigen::AlignedBox3d& box = bounds_[part];
-  Vec3 centre = box.center();
-  // The face behind the part: the pad pushes it along `direction`.
-  centre[axis] = (sign > 0 ? box.min()[axis] : box.max()[axis]) - sign * arm_.pad_thickness / 2;
-  return product_.product.parts()[part].final_pose.inverse() * translation(centre);
-}
-
-HeldPart AssemblyScene::hold(PartIndex part, const Vec3& direction) const {
-  const auto [axis, sign] = dominant_axis(direction);
-  const Eigen::Vector3d pad = pad_half_extents(part, direction);
-  Eigen::Vector3d carriage = Eigen::Vector3d::Constant(arm_.carriage_width / 2);
-  carriage[axis] = arm_.carriage_length / 2;
-  // In the gripper's frame (world-aligned at the final pose): the carriage runs away from
-  // the part, behind the pad.
-  Vec3 carriage_offset = Vec3::Zero();
-  carriage_offset[axis] = -sign * (arm_.pad_thickness / 2 + arm_.carriage_length / 2);
-
+HeldPart AssemblyScene::hold(PartIndex part, const Grasp& grasp) const {
   const double margin = world_.options().shape_margin;
   HeldPart held;
-  held.grip = grip_offset(part, direction);
   if (const auto& mesh = product_.meshes[part]) held.with_arm.add_mesh("part", *mesh, Pose::Identity(), margin);
-  held.with_arm.add_box("gripper", pad, held.grip, margin);
-  held.with_arm.add_box("carriage", carriage, held.grip * translation(carriage_offset), margin);
-  held.arm.add_box("gripper", pad, Pose::Identity(), margin);
-  held.arm.add_box("carriage", carriage, translation(carriage_offset), margin);
+  for (const auto& box : fb::gripper_boxes(gripper_, grasp.opening)) {
+    const std::string member = box.name.rfind("finger", 0) == 0 ? "finger" : box.name;
+    held.with_arm.add_box(member, box.half_extents, grasp.gripper * box.pose, margin);
+    held.arm.add_box(member, box.half_extents, box.pose, margin);
+  }
   return held;
 }
 
@@ -134,7 +106,7 @@ std::optional<Collision> AssemblyScene::collision_at(const sim::MovingBody& body
 std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {
   const auto& w = trajectory.waypoints;
   if (w.empty()) return std::nullopt;
-  const HeldPart held = hold(part, trajectory.grip_direction);
+  const HeldPart held = hold(part, trajectory.grasp);
   if (w.front().holding) {
     if (auto c = collision_at(held.with_arm, w.front().part, w.front().phase)) return c;
   }
@@ -144,6 +116,24 @@ std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajector
     if (contact) return to_collision(*contact, w[i].phase);
   }
   return std::nullopt;
+}
+
+std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajectory& trajectory) const {
+  std::vector<Grasp> all = grasps(part, trajectory.direction);
+  if (all.empty()) {
+    // Narrower than the gripper opens on no pair of faces: by how much, at the narrowest.
+    return Collision{"", "gripper", final_bounds(part).sizes().minCoeff() - gripper_.max_opening, "grasp"};
+  }
+  const Grasp own = trajectory.grasp;
+  std::optional<Collision> first = simulate(part, trajectory);
+  if (!first || first->member == "part") return first;  // no other grasp helps a part that hits
+  for (const Grasp& g : all) {
+    if (g.label == own.label) continue;
+    trajectory.hold_by(g);
+    if (!simulate(part, trajectory)) return std::nullopt;
+  }
+  trajectory.hold_by(own);
+  return first;
 }
 
 Collision AssemblyScene::to_collision(const sim::Contact& contact, const std::string& phase) const {

@@ -1,7 +1,7 @@
 #pragma once
 // The virtual cell for one product: the station's surface, the parts assembled so far as
-// static bodies, and the arm (gripper pad and carriage) with the part it holds. Virtual
-// assembly runs trajectories here; collisions with parts, station and arm all count.
+// static bodies, and the arm's gripper (palm, fingers, carriage) with the part it holds.
+// Virtual assembly runs trajectories here; collisions with parts, station and arm all count.
 
 #include <map>
 #include <optional>
@@ -14,33 +14,25 @@
 
 namespace twin {
 
-struct ArmGeometry {
-  double pad_thickness = 0.010;   // m, along the push direction
-  double pad_max_width = 0.030;   // m, the pad is at most this wide, at most the part's face
-  double carriage_width = 0.020;  // m, square section
-  double carriage_length = 0.150; // m, from the pad away from the part
-};
-
 struct Collision {
   std::string with;     // a part's name or "station"
-  std::string member;   // what hit it: "part", "gripper", "carriage"
+  std::string member;   // what hit it: "part", "finger", "palm", "carriage"
   double depth = 0;     // m
-  std::string phase;    // of the trajectory
+  std::string phase;    // of the trajectory; "grasp": no grasp fits the part (depth: by how much)
 };
 
 // The part in the gripper, as the collision world sees it.
 struct HeldPart {
-  sim::MovingBody with_arm;  // part + gripper pad + carriage, in the part's frame
-  sim::MovingBody arm;       // gripper pad + carriage, in the gripper's frame
-  Pose grip = Pose::Identity();  // the gripper's frame in the part's frame
+  sim::MovingBody with_arm;  // part + gripper, in the part's frame
+  sim::MovingBody arm;       // the gripper, in its own frame
 };
 
 class AssemblyScene {
  public:
-  AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options = {}, ArmGeometry arm = {});
+  AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options = {}, fb::GripperGeometry gripper = {});
 
   const LoadedProduct& product() const { return product_; }
-  const ArmGeometry& arm() const { return arm_; }
+  const fb::GripperGeometry& gripper() const { return gripper_; }
 
   void assemble(PartIndex part);
   void disassemble(PartIndex part);
@@ -56,21 +48,20 @@ class AssemblyScene {
   const std::set<PartIndex>& frontier() const { return frontier_; }
   bool stands_on_surface(PartIndex part) const;
 
-  // Where the gripper pad sits on the part for a push along `direction`: on the face behind
-  // it, in the part's frame.
-  Pose grip_offset(PartIndex part, const Vec3& direction) const;
-
-  // The part held for a push along `direction`: the pad on the face behind it, the carriage
-  // running away from the part.
-  HeldPart hold(PartIndex part, const Vec3& direction) const;
-  // Half extents of the gripper pad for that push: as wide as the part's face, at most
-  // pad_max_width, pad_thickness along the push.
-  Eigen::Vector3d pad_half_extents(PartIndex part, const Vec3& direction) const;
+  // The gripper's grasps on the part for a push along `direction`, best first (grasp.hpp).
+  std::vector<Grasp> grasps(PartIndex part, const Vec3& direction) const;
+  // The part in the gripper, held by `grasp`.
+  HeldPart hold(PartIndex part, const Grasp& grasp) const;
   std::optional<Collision> collision_at(const sim::MovingBody& body, const Pose& pose, const std::string& phase) const;
 
   // Runs the trajectory in the collision world: the held part with the arm, then the arm
   // alone once it has let go. The first collision, or nothing.
   std::optional<Collision> simulate(PartIndex part, const Trajectory& trajectory) const;
+  // Runs the trajectory with its own grasp, then with the part's other grasps for its
+  // direction, and keeps the first that is free of collisions through insertion and
+  // retreat. Where none is, the trajectory keeps its own grasp and the answer is its
+  // collision (or, with no grasp at all, one of phase "grasp").
+  std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory) const;
 
   const sim::CollisionWorld& world() const { return world_; }
 
@@ -78,7 +69,7 @@ class AssemblyScene {
   Collision to_collision(const sim::Contact& contact, const std::string& phase) const;
 
   const LoadedProduct& product_;
-  ArmGeometry arm_;
+  fb::GripperGeometry gripper_;
   sim::CollisionWorld world_;
   std::vector<PartIndex> neighbours(PartIndex part) const;
   bool linked_to_assembled(PartIndex part) const;

@@ -37,19 +37,20 @@ Trajectory LinearPathPlanner::straight_insertion(const AssemblyScene& scene, Par
   // Raise the start above everything, so that the part arrives from a safe height.
   const double raise = std::max(0.0, around.max().y() + kClearance - (part_box.min().y() - direction.y() * distance));
 
-  const Pose grip = scene.grip_offset(part, direction);
   Trajectory t;
   t.direction = direction;
-  t.grip_direction = direction;
+  t.retreat = distance;
   t.label = label;
-  auto add = [&](const char* phase, const Pose& part_pose, const Pose& gripper, bool holding) {
-    t.waypoints.push_back({phase, part_pose, gripper, holding});
+  auto add = [&](const char* phase, const Pose& part_pose, bool holding) {
+    t.waypoints.push_back({phase, part_pose, part_pose, holding});
   };
-  if (raise > 1e-9) add("approach", moved(pre, Vec3::UnitY() * raise), moved(pre, Vec3::UnitY() * raise) * grip, true);
-  add(raise > 1e-9 ? "transit" : "approach", pre, pre * grip, true);
-  add("insert", final_pose, final_pose * grip, true);
-  add("release", final_pose, final_pose * grip, false);
-  add("retreat", final_pose, moved(final_pose * grip, -direction * distance), false);
+  if (raise > 1e-9) add("approach", moved(pre, Vec3::UnitY() * raise), true);
+  add(raise > 1e-9 ? "transit" : "approach", pre, true);
+  add("insert", final_pose, true);
+  add("release", final_pose, false);
+  add("retreat", final_pose, false);
+  const auto grasps = scene.grasps(part, direction);
+  t.hold_by(grasps.empty() ? Grasp{} : grasps.front());
   return t;
 }
 

@@ -85,15 +85,17 @@ std::optional<Trajectory> OmplPathPlanner::next(const AssemblyScene& scene, Part
   if (tried.size() < directions.size()) return linear_.next(scene, part, tried);
   // Then one sampling run for each face the gripper can hold the part by.
   for (std::size_t k = tried.size() - directions.size(); k < directions.size(); ++k) {
-    if (auto t = sample_path(scene, part, directions[k].second)) return t;
+    const auto grasps = scene.grasps(part, directions[k].second);
+    if (grasps.empty()) continue;
+    if (auto t = sample_path(scene, part, grasps.front())) return t;
   }
   return std::nullopt;
 }
 
 std::optional<Trajectory> OmplPathPlanner::sample_path(const AssemblyScene& scene, PartIndex part,
-                                                       const Vec3& grip_direction) const {
+                                                       const Grasp& grasp) const {
   const Pose goal = scene.product().product.parts()[part].final_pose;
-  const HeldPart held = scene.hold(part, grip_direction);
+  const HeldPart held = scene.hold(part, grasp);
   const Eigen::AlignedBox3d part_box = scene.final_bounds(part);
   Eigen::AlignedBox3d around = scene.assembled_bounds();
   around.extend(part_box);
@@ -145,23 +147,21 @@ std::optional<Trajectory> OmplPathPlanner::sample_path(const AssemblyScene& scen
 
   Trajectory t;
   t.label = "ompl";
-  t.grip_direction = grip_direction;
+  t.retreat = options_.retreat;
   const auto& states = setup.getSolutionPath().getStates();
   for (std::size_t i = 0; i < states.size(); ++i) {
     const Pose p = to_pose(states[i]);
     const char* phase = i == 0 ? "approach" : (i + 1 == states.size() ? "insert" : "transit");
-    t.waypoints.push_back({phase, p, p * held.grip, true});
+    t.waypoints.push_back({phase, p, p, true});
   }
   t.waypoints.back().part = goal;  // exactly, not to the planner's tolerance
-  t.waypoints.back().gripper = goal * held.grip;
   if (t.waypoints.size() >= 2) {
     const Vec3 last = goal.translation() - t.waypoints[t.waypoints.size() - 2].part.translation();
     if (last.norm() > 1e-9) t.direction = last.normalized();
   }
-  t.waypoints.push_back({"release", goal, goal * held.grip, false});
-  Pose away = goal * held.grip;
-  away.translation() -= grip_direction * options_.retreat;
-  t.waypoints.push_back({"retreat", goal, away, false});
+  t.waypoints.push_back({"release", goal, goal, false});
+  t.waypoints.push_back({"retreat", goal, goal, false});
+  t.hold_by(grasp);
   return t;
 }
 

@@ -28,7 +28,7 @@ class OmplPathPlanner : public PathPlanner {
                                  const std::vector<Attempt>& tried) override;
 
  private:
-  std::optional<Trajectory> sample_path(const AssemblyScene& scene, PartIndex part, const Vec3& grip_direction) const;
+  std::optional<Trajectory> sample_path(const AssemblyScene& scene, PartIndex part, const Grasp& grasp) const;
 
   OmplOptions options_;
   LinearPathPlanner linear_;

@@ -28,7 +28,8 @@ class PathPlanner {
 
 // Straight insertion along candidate directions: down, up from below, +x, -x, +z, -z. The
 // part comes from a safe height to a point clear of the assembly along the direction,
-// moves straight in, is released, and the arm backs out the way it came.
+// moves straight in, is released, and the arm backs out along its carriage. The trajectory
+// holds the part by its first grasp for the direction; virtual assembly may choose another.
 class LinearPathPlanner : public PathPlanner {
  public:
   std::string name() const override { return "linear"; }

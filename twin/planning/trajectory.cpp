@@ -10,4 +10,11 @@ double Trajectory::path_length() const {
   return length;
 }
 
+void Trajectory::hold_by(const Grasp& g) {
+  grasp = g;
+  Pose back = Pose::Identity();
+  back.translation() = Vec3(0, retreat, 0);
+  for (Waypoint& w : waypoints) w.gripper = w.part * g.gripper * (w.phase == "retreat" ? back : Pose::Identity());
+}
+
 }  // namespace twin

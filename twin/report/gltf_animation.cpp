@@ -115,12 +115,26 @@ sim::TriangleMesh box_mesh(const Eigen::AlignedBox3d& box) {
   return m;
 }
 
+// The gripper with its fingers `opening` apart, as one mesh of its boxes.
+sim::TriangleMesh gripper_mesh(const fb::GripperGeometry& gripper, double opening) {
+  sim::TriangleMesh out;
+  for (const auto& box : fb::gripper_boxes(gripper, opening)) {
+    const Vec3 c = box.pose.translation();
+    const sim::TriangleMesh m = box_mesh({c - box.half_extents, c + box.half_extents});
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
+    out.vertices.insert(out.vertices.end(), m.vertices.begin(), m.vertices.end());
+    for (const auto& tri : m.triangles) out.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
+  }
+  return out;
+}
+
 // Keyframes of one node: times, translations, rotations, scales.
 struct Track {
   std::vector<float> times, translations, rotations, scales;
   void key(double t, const Pose& pose, double scale) {
-    if (!times.empty() && t <= times.back()) t = times.back() + 1e-4;  // strictly increasing
-    times.push_back(static_cast<float>(t));
+    float at = static_cast<float>(t);
+    if (!times.empty() && at <= times.back()) at = times.back() + 1e-4f;  // strictly increasing, as stored
+    times.push_back(at);
     const Quat q(pose.linear());
     translations.insert(translations.end(), {float(pose.translation().x()), float(pose.translation().y()),
                                              float(pose.translation().z())});
@@ -161,41 +175,39 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
     const int material = gltf.material(parts[i].name, color_rgba(parts[i].color));
     part_nodes[i] = gltf.node(parts[i].name, gltf.mesh(parts[i].name, geometry[mesh], material), parts[i].final_pose);
   }
-  // The arm: a 30 x 10 x 30 mm pad, its carriage above it along the gripper's +Y.
+  // The arm's gripper: one node per step (its fingers stand as far apart as that step's
+  // part is wide), shown during its step only.
   const int arm_material = gltf.material("arm", {0.9, 0.45, 0.05, 1});
-  const int pad = gltf.mesh("gripper", gltf.geometry(box_mesh({Vec3(-0.015, -0.005, -0.015), Vec3(0.015, 0.005, 0.015)})), arm_material);
-  const int carriage = gltf.mesh("carriage", gltf.geometry(box_mesh({Vec3(-0.01, 0.005, -0.01), Vec3(0.01, 0.155, 0.01)})), arm_material);
-  const int arm = gltf.node("arm", pad, Pose::Identity());
-  const int carriage_node = gltf.node("carriage", carriage, Pose::Identity());
-  gltf.model.nodes[arm].children.push_back(carriage_node);
+  std::vector<std::pair<int, Track>> grippers;
 
   // Time line: steps one after the other; a part is hidden (scale 0) until its step.
   std::vector<Track> part_tracks(parts.size());
-  Track arm_track;
   double t = 0;
   for (const auto& step : plan.steps) {
     const auto& w = step.trajectory.waypoints;
     if (w.empty()) continue;
-    // The carriage points away from the part: gripper +Y turned onto -grip_direction.
-    const Quat arm_turn = Quat::FromTwoVectors(Vec3::UnitY(), -step.trajectory.grip_direction.normalized());
-    auto arm_pose = [&](const Pose& gripper) {
-      Pose p = gripper;
-      p.linear() = gripper.linear() * arm_turn.toRotationMatrix();
-      return p;
-    };
+    const std::string name = "gripper (" + parts[step.part].name + ")";
+    const int node = gltf.node(name, gltf.mesh(name, gltf.geometry(gripper_mesh(options.gripper, step.trajectory.grasp.opening)),
+                                               arm_material), w.front().gripper);
+    Track& arm_track = grippers.emplace_back(node, Track{}).second;
+    arm_track.key(0, w.front().gripper, 0);
     Track& track = part_tracks[step.part];
     track.key(0, w.front().part, 0);
-    if (t > 0) track.key(t, w.front().part, 0);
+    if (t > 0) {
+      track.key(t, w.front().part, 0);
+      arm_track.key(t, w.front().gripper, 0);
+    }
     t += options.gap;
     track.key(t, w.front().part, 1);
-    arm_track.key(t, arm_pose(w.front().gripper), 1);
+    arm_track.key(t, w.front().gripper, 1);
     for (std::size_t i = 1; i < w.size(); ++i) {
       const double moved = std::max((w[i].part.translation() - w[i - 1].part.translation()).norm(),
                                     (w[i].gripper.translation() - w[i - 1].gripper.translation()).norm());
       t += std::max(options.min_segment, moved / options.speed);
       track.key(t, w[i].part, 1);
-      arm_track.key(t, arm_pose(w[i].gripper), 1);
+      arm_track.key(t, w[i].gripper, 1);
     }
+    arm_track.key(t, w.back().gripper, 0);  // gone with its step
   }
 
   tinygltf::Animation animation;
@@ -221,7 +233,7 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
     }
   };
   for (PartIndex i = 0; i < parts.size(); ++i) add_track(part_nodes[i], part_tracks[i]);
-  add_track(arm, arm_track);
+  for (const auto& [node, track] : grippers) add_track(node, track);
   if (!animation.channels.empty()) gltf.model.animations.push_back(animation);
 
   tinygltf::Scene scene;
@@ -229,7 +241,7 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
   for (int n : part_nodes) {
     if (n >= 0) scene.nodes.push_back(n);
   }
-  scene.nodes.push_back(arm);
+  for (const auto& [node, track] : grippers) scene.nodes.push_back(node);
   gltf.model.scenes.push_back(scene);
   gltf.model.defaultScene = 0;
 

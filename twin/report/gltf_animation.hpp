@@ -1,7 +1,8 @@
 #pragma once
 // The virtual assembly as a glTF 2.0 animation for the designer: one node per part (with its
-// colour) and one for the arm (gripper pad and carriage); every part appears when its step
-// starts and follows its trajectory; the arm follows the gripper. Opens in Blender, three.js
+// colour) and one for the gripper in each step (palm, fingers as far apart as the part is
+// wide, carriage); every part appears when its step starts and follows its trajectory, its
+// gripper with it. Opens in Blender, three.js
 // and any glTF viewer.
 
 #include <array>
@@ -17,6 +18,7 @@ struct AnimationOptions {
   double speed = 0.1;         // m/s of the part along its trajectory
   double min_segment = 0.25;  // s, for segments that do not move the part (release)
   double gap = 0.5;           // s between steps, while the arm moves to the next part
+  fb::GripperGeometry gripper;
 };
 
 // Writes a self-contained .gltf (buffers embedded). Throws std::runtime_error if it cannot.

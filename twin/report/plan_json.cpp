@@ -22,7 +22,8 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                             {"holding", w.holding},
                             {"position", vec(w.part.translation())},
                             {"orientation", quat(w.part)},
-                            {"gripper_position", vec(w.gripper.translation())}});
+                            {"gripper_position", vec(w.gripper.translation())},
+                            {"gripper_orientation", quat(w.gripper)}});
     }
     nlohmann::json failed = nlohmann::json::array();
     for (const auto& a : step.failed) {
@@ -38,6 +39,10 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                      {"type", short_type_name(part.type)},
                      {"label", step.trajectory.label},
                      {"direction", vec(step.trajectory.direction)},
+                     {"grasp", {{"label", step.trajectory.grasp.label},
+                                {"opening", step.trajectory.grasp.opening},
+                                {"position", vec(step.trajectory.grasp.gripper.translation())},
+                                {"orientation", quat(step.trajectory.grasp.gripper)}}},
                      {"path_length", step.trajectory.path_length()},
                      {"tries", step.failed.size() + 1},
                      {"failed_tries", failed},

@@ -1,0 +1,61 @@
+#include "twin/planning/grasp.hpp"
+
+#include <algorithm>
+
+namespace twin {
+namespace {
+
+const char* const kAxis[] = {"x", "y", "z"};
+
+std::string side_name(int axis, double sign) {
+  if (axis == 1) return sign > 0 ? "above" : "below";
+  return std::string(sign > 0 ? "+" : "-") + kAxis[axis];
+}
+
+}  // namespace
+
+std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_pose, const Vec3& direction,
+                              const fb::GripperGeometry& gripper) {
+  int push_axis = 0;
+  direction.cwiseAbs().maxCoeff(&push_axis);
+  const double push_sign = direction[push_axis] > 0 ? 1.0 : -1.0;
+
+  // The carriage's sides, best first: behind the push, above, then the rest.
+  std::vector<std::pair<int, double>> sides{{push_axis, -push_sign}, {1, 1.0}};
+  for (int axis : {0, 2, 1}) {
+    for (double sign : {1.0, -1.0}) sides.emplace_back(axis, sign);
+  }
+  std::vector<std::pair<int, double>> unique_sides;
+  for (const auto& s : sides) {
+    const bool ahead = s.first == push_axis && s.second == push_sign;
+    if (!ahead && std::find(unique_sides.begin(), unique_sides.end(), s) == unique_sides.end()) unique_sides.push_back(s);
+  }
+
+  const Vec3 size = box.sizes();
+  std::vector<Grasp> out;
+  for (const auto& [side_axis, side_sign] : unique_sides) {
+    std::vector<int> closing;
+    for (int a = 0; a < 3; ++a) {
+      if (a != side_axis && size[a] <= gripper.max_opening) closing.push_back(a);
+    }
+    std::sort(closing.begin(), closing.end(), [&](int a, int b) { return size[a] < size[b]; });
+    const double depth = size[side_axis];
+    const double reach = std::min(gripper.finger_length, depth / 2);
+    for (int close : closing) {
+      Vec3 x = Vec3::Zero(), y = Vec3::Zero();
+      x[close] = 1;
+      y[side_axis] = side_sign;
+      Pose world = Pose::Identity();
+      world.linear().col(0) = x;
+      world.linear().col(1) = y;
+      world.linear().col(2) = x.cross(y);
+      // The palm stands off the part's face so that the fingertips reach `reach` into it.
+      world.translation() = box.center() + y * (depth / 2 + gripper.finger_length - reach + gripper.palm_thickness / 2);
+      out.push_back({final_pose.inverse() * world, size[close],
+                     std::string("across ") + kAxis[close] + " from " + side_name(side_axis, side_sign)});
+    }
+  }
+  return out;
+}
+
+}  // namespace twin
