@@ -135,6 +135,14 @@ void Negotiator::tick() {
     reason += " within " + std::to_string(settings_.wait.count() / 1000) + " s";
     std::string why;
     for (const auto& [resource, r] : c.refusals) why += (why.empty() ? "" : "; ") + resource + ": " + r;
+    // A live resource that offers the operation and said nothing at all: its answers do not
+    // reach this process (a DDS match lost under load), which the operator should know.
+    const std::string& operation = get<std::string>(c.data, "operation");
+    for (const auto& [resource, ops] : operations_) {
+      if (ops.count(operation) && !c.refusals.count(resource)) {
+        why += (why.empty() ? "" : "; ") + resource + " offers " + operation + " but never answered";
+      }
+    }
     reason += why.empty() ? " (no resource with that operation answered)" : " (" + why + ")";
     calls_.erase(id);
     emit("UNAVAILABLE", {{"call_id", id}, {"reason", reason}});

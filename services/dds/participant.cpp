@@ -1,8 +1,10 @@
 #include "services/dds/participant.hpp"
 
+#include <iostream>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -10,6 +12,28 @@
 namespace dds {
 
 constexpr std::uint32_t kMaxParticipantsPerHost = 32;
+
+namespace {
+
+// Says when another participant's lease ran out while it may still live (a process starved
+// of CPU for the whole lease): until discovery matches the two again, what they write to
+// each other is lost, and a call that gets no answer from a live resource is the sign.
+class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
+ public:
+  explicit DiscoveryLog(std::string name) : name_(std::move(name)) {}
+  void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    if (info.status == eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
+      std::cerr << name_ << ": DDS participant " << info.info.m_participantName.to_string()
+                << " dropped: its discovery lease ran out\n";
+    }
+  }
+
+ private:
+  std::string name_;
+};
+
+}  // namespace
 
 ParticipantPtr make_participant(const std::string& name, const ParticipantSettings& settings) {
   using namespace eprosima::fastdds::dds;
@@ -39,12 +63,14 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
   qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(5.0);
   DomainParticipantFactory* factory = DomainParticipantFactory::get_instance();
-  DomainParticipant* participant = factory->create_participant(settings.domain_id, qos);
+  auto log = std::make_shared<DiscoveryLog>(name);
+  DomainParticipant* participant = factory->create_participant(settings.domain_id, qos, log.get(), StatusMask::none());
   if (!participant) {
     throw std::runtime_error("cannot create DDS participant '" + name + "' on domain " +
                              std::to_string(settings.domain_id));
   }
-  return ParticipantPtr(participant, [](DomainParticipant* p) {
+  return ParticipantPtr(participant, [log](DomainParticipant* p) {
+    p->set_listener(nullptr);
     p->delete_contained_entities();
     DomainParticipantFactory::get_instance()->delete_participant(p);
   });

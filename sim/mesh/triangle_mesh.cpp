@@ -38,7 +38,59 @@ void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
   for (unsigned c = 0; c < node.mNumChildren; ++c) append_node(scene, *node.mChildren[c], transform, out);
 }
 
-// Drops degenerate and duplicate triangles; counts open and non-manifold edges.
+bool has_edge(const std::array<std::uint32_t, 3>& t, std::uint32_t a, std::uint32_t b) {
+  for (int k = 0; k < 3; ++k) {
+    if (t[k] == a && t[(k + 1) % 3] == b) return true;
+  }
+  return false;
+}
+
+// Winds each connected piece one way, outwards (a CAD export may flip some normals): a
+// triangle wound like its neighbour across a shared edge is turned over, and a closed piece
+// whose volume comes out negative is turned inside out. Counts the triangles turned.
+void orient(TriangleMesh& mesh,
+            const std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>>& edges) {
+  auto& tris = mesh.triangles;
+  std::vector<bool> seen(tris.size(), false), turned(tris.size(), false);
+  const auto turn = [&](std::size_t i) {
+    std::swap(tris[i][1], tris[i][2]);
+    turned[i] = !turned[i];
+  };
+  for (std::size_t seed = 0; seed < tris.size(); ++seed) {
+    if (seen[seed]) continue;
+    std::vector<std::size_t> piece{seed};
+    seen[seed] = true;
+    bool closed = true;
+    for (std::size_t next = 0; next < piece.size(); ++next) {
+      const auto t = tris[piece[next]];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+        const auto& users = edges.at(std::minmax(a, b));
+        if (users.size() != 2) {
+          closed = false;
+          continue;  // open or non-manifold: no neighbour to agree with
+        }
+        const std::size_t n = users[0] == piece[next] ? users[1] : users[0];
+        if (seen[n]) continue;
+        if (has_edge(tris[n], a, b)) turn(n);  // runs the shared edge the same way: turned over
+        seen[n] = true;
+        piece.push_back(n);
+      }
+    }
+    double volume = 0;
+    for (std::size_t i : piece) {
+      const auto& t = tris[i];
+      volume += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
+    }
+    if (closed && volume < 0) {
+      for (std::size_t i : piece) turn(i);
+    }
+  }
+  mesh.repairs.flipped = static_cast<std::size_t>(std::count(turned.begin(), turned.end(), true));
+}
+
+// Drops degenerate and duplicate triangles; counts open and non-manifold edges; winds the
+// triangles outwards.
 void repair(TriangleMesh& mesh) {
   using Corners = std::array<std::uint32_t, 3>;
   std::set<Corners> seen;
@@ -60,14 +112,16 @@ void repair(TriangleMesh& mesh) {
     kept.push_back(t);
   }
   mesh.triangles = std::move(kept);
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;  // undirected edge -> triangles
-  for (const auto& t : mesh.triangles) {
-    for (int k = 0; k < 3; ++k) ++edges[std::minmax(t[k], t[(k + 1) % 3])];
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>> edges;  // undirected edge -> triangles
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const auto& t = mesh.triangles[i];
+    for (int k = 0; k < 3; ++k) edges[std::minmax(t[k], t[(k + 1) % 3])].push_back(i);
   }
-  for (const auto& [edge, count] : edges) {
-    if (count == 1) ++mesh.repairs.open_edges;
-    if (count > 2) ++mesh.repairs.non_manifold_edges;
+  for (const auto& [edge, users] : edges) {
+    if (users.size() == 1) ++mesh.repairs.open_edges;
+    if (users.size() > 2) ++mesh.repairs.non_manifold_edges;
   }
+  orient(mesh, edges);
 }
 
 }  // namespace
@@ -79,6 +133,8 @@ std::string TriangleMesh::Repairs::describe() const {
   };
   say(degenerate, "degenerate triangle dropped", "degenerate triangles dropped");
   say(duplicate, "duplicate triangle dropped", "duplicate triangles dropped");
+  say(flipped, "triangle turned to face outwards (its normal was flipped)",
+      "triangles turned to face outwards (their normals were flipped)");
   say(open_edges, "open edge (the mesh is not closed)", "open edges (the mesh is not closed)");
   say(non_manifold_edges, "edge shared by more than two triangles", "edges shared by more than two triangles");
   std::string out;

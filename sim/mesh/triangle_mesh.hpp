@@ -27,10 +27,12 @@ struct TriangleMesh {
 
   // What loading found and repaired (a CAD export is rarely clean). Degenerate triangles
   // (a repeated corner, or no area) and duplicates (the same three corners) are dropped;
-  // edges with one triangle (open) or more than two (non-manifold) are counted.
+  // triangles wound against their neighbours, or a closed piece wound inside out, are turned
+  // to face outwards (flipped); edges with one triangle (open) or more than two
+  // (non-manifold) are counted.
   struct Repairs {
-    std::size_t degenerate = 0, duplicate = 0, open_edges = 0, non_manifold_edges = 0;
-    bool any() const { return degenerate + duplicate + open_edges + non_manifold_edges > 0; }
+    std::size_t degenerate = 0, duplicate = 0, flipped = 0, open_edges = 0, non_manifold_edges = 0;
+    bool any() const { return degenerate + duplicate + flipped + open_edges + non_manifold_edges > 0; }
     std::string describe() const;  // "dropped 3 degenerate triangles; 12 open edges", or ""
   } repairs;
 };

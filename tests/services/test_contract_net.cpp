@@ -182,6 +182,8 @@ TEST_CASE("negotiator: a bid evaluator of the cell's own decides", "[fb][negotia
 TEST_CASE("negotiator: a call nobody bids on is called again, then unavailable with every reason", "[fb][negotiation]") {
   fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", quick());
   f.send("CAPABILITY", capability("buffer-1", "give"));
+  f.send("CAPABILITY", capability("buffer-2", "give"));
+  f.send("CAPABILITY", capability("robot-1", "fetch"));
   f.send("CALL", cfp("o1", "give"));
   CHECK(f.send("PROPOSAL", {{"call_id", std::string("o1/give")}, {"resource_id", std::string("buffer-1")},
                             {"available", false}, {"reason", std::string("buffer-1 has 0 Shaft free, not 1")},
@@ -190,7 +192,12 @@ TEST_CASE("negotiator: a call nobody bids on is called again, then unavailable w
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
   const auto out = f.send("TICK");
   REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
-  CHECK(fb::get<std::string>(out[0].data, "reason").find("buffer-1: buffer-1 has 0 Shaft free, not 1") != std::string::npos);
+  const std::string& reason = fb::get<std::string>(out[0].data, "reason");
+  CHECK(reason.find("buffer-1: buffer-1 has 0 Shaft free, not 1") != std::string::npos);
+  // A live resource that offers the operation and never answered is named: its answers do
+  // not reach the order.
+  CHECK(reason.find("buffer-2 offers give but never answered") != std::string::npos);
+  CHECK(reason.find("robot-1") == std::string::npos);
 }
 
 TEST_CASE("negotiator: the awarded resource disappears before it confirms: the next bid wins", "[fb][negotiation]") {

@@ -66,3 +66,22 @@ TEST_CASE("a careless export: degenerate and duplicate triangles are dropped, op
         "1 degenerate triangle dropped; 1 duplicate triangle dropped; 4 open edges (the mesh is not closed)");
   CHECK_FALSE(sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3)->repairs.any());
 }
+
+TEST_CASE("flipped normals: triangles wound against their neighbours, or a piece inside out, are turned and said",
+          "[mesh][repairs]") {
+  const auto volume = [](const sim::TriangleMesh& m) {
+    double v = 0;
+    for (const auto& t : m.triangles) v += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6;
+    return v;
+  };
+  const auto flipped = sim::load_mesh(data("planning/messy/meshes/flipped_block_mm.obj"), 1e-3);
+  CHECK(flipped->repairs.flipped == 2);
+  CHECK(volume(*flipped) == Approx(8e-6));  // 20 mm cubed, outwards
+  CHECK(flipped->convex);
+  CHECK(flipped->repairs.describe() == "2 triangles turned to face outwards (their normals were flipped)");
+
+  const auto inside_out = sim::load_mesh(data("planning/messy/meshes/inside_out_block_mm.obj"), 1e-3);
+  CHECK(inside_out->repairs.flipped == 12);
+  CHECK(volume(*inside_out) == Approx(8e-6));
+  CHECK(inside_out->convex);
+}

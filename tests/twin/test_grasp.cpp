@@ -28,10 +28,11 @@ TEST_CASE("grasps: behind the push first, the narrower faces first, never ahead 
   const Eigen::AlignedBox3d box(Vec3(0.092, 0, -0.005), Vec3(0.108, 0.024, 0.005));
   const fb::GripperGeometry gripper;
   const auto grasps = twin::grasps_for(box, at(Vec3(0.1, 0, 0)), -Vec3::UnitY(), gripper);
-  REQUIRE(grasps.size() == 10);  // five sides, two pairs of faces each
+  REQUIRE(grasps.size() == 20);  // five sides, two pairs of faces each, two depths
   CHECK(grasps[0].label == "across z from above");
   CHECK(grasps[0].opening == Approx(0.010));
-  CHECK(grasps[1].label == "across x from above");
+  CHECK(grasps[1].label == "across z from above, shallow");
+  CHECK(grasps[2].label == "across x from above");
   for (const auto& g : grasps) {
     INFO(g.label);
     const twin::Pose world = at(Vec3(0.1, 0, 0)) * g.gripper;
@@ -43,6 +44,9 @@ TEST_CASE("grasps: behind the push first, the narrower faces first, never ahead 
   // underside stands 18 mm above its top (the gripper's origin is the palm's centre).
   CHECK((at(Vec3(0.1, 0, 0)) * grasps[0].gripper).translation().isApprox(
       Vec3(0.1, 0.024 + 0.018 + gripper.palm_thickness / 2, 0), 1e-12));
+  // A shallow grasp, a quarter of the way down: 6 mm.
+  CHECK((at(Vec3(0.1, 0, 0)) * grasps[1].gripper).translation().isApprox(
+      Vec3(0.1, 0.024 + 0.024 + gripper.palm_thickness / 2, 0), 1e-12));
 
   // Pushed along +x: the carriage behind, on -x, comes first; none stands on +x.
   const auto sideways = twin::grasps_for(box, at(Vec3(0.1, 0, 0)), Vec3::UnitX(), gripper);

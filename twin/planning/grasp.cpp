@@ -40,7 +40,6 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
     }
     std::sort(closing.begin(), closing.end(), [&](int a, int b) { return size[a] < size[b]; });
     const double depth = size[side_axis];
-    const double reach = std::min(gripper.finger_length, depth / 2);
     for (int close : closing) {
       Vec3 x = Vec3::Zero(), y = Vec3::Zero();
       x[close] = 1;
@@ -49,10 +48,16 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
       world.linear().col(0) = x;
       world.linear().col(1) = y;
       world.linear().col(2) = x.cross(y);
-      // The palm stands off the part's face so that the fingertips reach `reach` into it.
-      world.translation() = box.center() + y * (depth / 2 + gripper.finger_length - reach + gripper.palm_thickness / 2);
-      out.push_back({final_pose.inverse() * world, size[close],
-                     std::string("across ") + kAxis[close] + " from " + side_name(side_axis, side_sign)});
+      const std::string label = std::string("across ") + kAxis[close] + " from " + side_name(side_axis, side_sign);
+      // Half-way into the part, then a quarter (out of a bore the part sinks into).
+      const double half = std::min(gripper.finger_length, depth / 2), quarter = std::min(gripper.finger_length, depth / 4);
+      for (const bool shallow : {false, true}) {
+        if (shallow && quarter == half) break;
+        // The palm stands off the part's face so that the fingertips reach `reach` into it.
+        const double reach = shallow ? quarter : half;
+        world.translation() = box.center() + y * (depth / 2 + gripper.finger_length - reach + gripper.palm_thickness / 2);
+        out.push_back({final_pose.inverse() * world, size[close], label + (shallow ? ", shallow" : "")});
+      }
     }
   }
   return out;

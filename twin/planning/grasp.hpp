@@ -1,8 +1,8 @@
 #pragma once
 // How the arm's two-finger parallel gripper holds a part: its fingers on a pair of opposite
 // faces of the part's box (across a cylinder, its diameter), the carriage on one side. A part
-// pushed along a direction has up to ten grasps; the planner takes the first one that is free
-// of collisions through insertion and retreat.
+// pushed along a direction has up to twenty grasps; the planner takes the first one that is
+// free of collisions through insertion and retreat.
 
 #include <string>
 #include <vector>
@@ -21,8 +21,9 @@ struct Grasp {
 // The grasps on a part whose box in the finished product is `box` (world axes; the part's
 // final pose is `final_pose`), for a push along `direction`, best first: the carriage behind
 // the push, then above, then beside; never ahead of it. For each side, the narrower pair of
-// faces first; a pair wider than the gripper opens is left out. The fingers reach at most
-// half-way into the part, so that they stay out of the hole it goes into.
+// faces first; a pair wider than the gripper opens is left out. The fingers reach half-way
+// into the part, and in a "shallow" grasp after it a quarter of the way, so that they stay
+// out of the bore the part goes into.
 std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_pose, const Vec3& direction,
                               const fb::GripperGeometry& gripper);
 
