@@ -60,8 +60,12 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   }
   // Announce the participant every 0.5 s instead of 3 s: a first announcement that no one
   // heard (a process starting while others start) otherwise delays discovery by seconds.
+  // The discovery lease stays Fast DDS's 20 s: with 5 s, a process starved of CPU for 5 s
+  // (ten twins under ThreadSanitizer on two cores) was dropped by the others, and the pair
+  // did not match again: every answer of a live buffer to one twin was lost. A process that
+  // dies is noticed by the 5 s liveliness of its capability, not by this lease.
   qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
-  qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(5.0);
+  qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(20.0);
   DomainParticipantFactory* factory = DomainParticipantFactory::get_instance();
   auto log = std::make_shared<DiscoveryLog>(name);
   DomainParticipant* participant = factory->create_participant(settings.domain_id, qos, log.get(), StatusMask::none());
