@@ -1,5 +1,7 @@
 #include "sim/mesh/triangle_mesh.hpp"
 
+#include "sim/mesh/mesh_disk_cache.hpp"
+
 #include <LinearMath/btConvexHullComputer.h>
 
 #include <algorithm>
@@ -190,10 +192,15 @@ bool is_convex(const TriangleMesh& mesh) {
   return hull_volume > 0 && std::abs(volume) >= (1 - 1e-3) * hull_volume && std::abs(volume) <= (1 + 1e-3) * hull_volume;
 }
 
+MeshCache::MeshCache() : MeshCache(MeshDiskCache::folder_from_environment()) {}
+
+MeshCache::MeshCache(const std::optional<std::filesystem::path>& disk_folder)
+    : disk_(disk_folder ? std::make_shared<MeshDiskCache>(*disk_folder) : nullptr) {}
+
 std::shared_ptr<const TriangleMesh> MeshCache::get(const std::filesystem::path& file, double scale) {
   const std::string key = file.string() + '@' + std::to_string(scale);
   if (auto it = meshes_.find(key); it != meshes_.end()) return it->second;
-  auto mesh = load_mesh(file, scale);
+  auto mesh = disk_ ? disk_->load(file, scale) : load_mesh(file, scale);
   meshes_.emplace(key, mesh);
   return mesh;
 }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -50,13 +51,19 @@ class MeshError : public std::runtime_error {
 // Throws MeshError when the file cannot be read or holds no triangles.
 std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file, double scale = 1);
 
-// Each file read once, shared by every part that uses it.
+class MeshDiskCache;
+
+// Each file read once, shared by every part that uses it; read through the disk cache
+// (mesh_disk_cache.hpp) that the environment names, or the one given (none: off).
 class MeshCache {
  public:
+  MeshCache();
+  explicit MeshCache(const std::optional<std::filesystem::path>& disk_folder);
   std::shared_ptr<const TriangleMesh> get(const std::filesystem::path& file, double scale = 1);
   std::size_t size() const { return meshes_.size(); }
 
  private:
+  std::shared_ptr<MeshDiskCache> disk_;
   std::unordered_map<std::string, std::shared_ptr<const TriangleMesh>> meshes_;
 };
 

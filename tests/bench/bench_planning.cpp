@@ -4,7 +4,9 @@
 //   build/release/tests/bench_planning
 // Figures and the command are recorded in docs/performance.md.
 
+#include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include <benchmark/benchmark.h>
 #include <unistd.h>
@@ -59,6 +61,85 @@ void BM_Tower(benchmark::State& state, const std::string& sequence) {
   std::filesystem::remove_all(file.parent_path());
 }
 
+// Twenty rings stacked, each its own one-piece concave mesh (a tube: 40 mm across, a 20 mm
+// bore, 5 mm tall) of about `triangles` triangles: OBJ files as a CAD export writes them.
+std::filesystem::path ring_stack(int triangles) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("bench-rings-" + std::to_string(::getpid()) + "-" + std::to_string(triangles));
+  std::filesystem::create_directories(dir);
+  const int segments = std::max(8, triangles / 8);
+  std::ostringstream aml;
+  aml << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<CAEXFile SchemaVersion=\"3.0\" FileName=\"rings.aml\" "
+         "xmlns=\"http://www.dke.de/CAEX\"><InstanceHierarchy Name=\"Order\"><InternalElement Name=\"Rings\" ID=\"rings\">\n";
+  std::ostringstream classes;
+  for (int r = 0; r < 20; ++r) {
+    const std::string name = "ring" + std::to_string(r);
+    std::ofstream obj(dir / (name + ".obj"));
+    obj << "o " << name << "\n";
+    const double outer = 0.020 + r * 1e-5, inner = 0.010;  // each file its own content
+    for (const double y : {0.0, 0.005}) {
+      for (int k = 0; k < segments; ++k) {
+        const double t = 2 * M_PI * k / segments;
+        obj << "v " << outer * std::cos(t) << ' ' << y << ' ' << outer * std::sin(t) << "\nv " << inner * std::cos(t)
+            << ' ' << y << ' ' << inner * std::sin(t) << '\n';
+      }
+    }
+    const auto o = [&](int level, int k) { return level * 2 * segments + 2 * (k % segments) + 1; };
+    for (int k = 0; k < segments; ++k) {
+      const int a = o(0, k), b = o(0, k + 1), c = o(1, k + 1), d = o(1, k);
+      obj << "f " << a << ' ' << c << ' ' << b << "\nf " << a << ' ' << d << ' ' << c << '\n';              // outside
+      obj << "f " << a + 1 << ' ' << b + 1 << ' ' << c + 1 << "\nf " << a + 1 << ' ' << c + 1 << ' ' << d + 1 << '\n';  // bore
+      obj << "f " << d << ' ' << c + 1 << ' ' << c << "\nf " << d << ' ' << d + 1 << ' ' << c + 1 << '\n';  // top
+      obj << "f " << a << ' ' << b << ' ' << b + 1 << "\nf " << a << ' ' << b + 1 << ' ' << a + 1 << '\n';  // bottom
+    }
+    aml << "<InternalElement Name=\"" << name << "\" ID=\"" << name << "\" RefBaseSystemUnitPath=\"Lib/R" << r << "\"/>\n";
+    if (r > 0) {
+      aml << "<InternalLink Name=\"l" << r << "\" RefPartnerSideA=\"ring" << r - 1 << ":top\" RefPartnerSideB=\"" << name
+          << ":bottom\"/>\n";
+    }
+    classes << "<SystemUnitClass Name=\"R" << r << "\">"
+            << "<Attribute Name=\"bottom\" Unit=\"mm\"><DefaultValue>0,0,0</DefaultValue></Attribute>"
+            << "<ExternalInterface Name=\"bottom\" ID=\"R" << r << "-bottom\"/>"
+            << "<Attribute Name=\"top\" Unit=\"mm\"><DefaultValue>0,5,0</DefaultValue></Attribute>"
+            << "<ExternalInterface Name=\"top\" ID=\"R" << r << "-top\"/>"
+            << "<ExternalInterface Name=\"geometry\" ID=\"R" << r << "-geometry\" RefBaseClassPath=\"ExternalDataReference\">"
+            << "<Attribute Name=\"refURI\"><Value>" << name << ".obj</Value></Attribute></ExternalInterface>"
+            << "</SystemUnitClass>\n";
+  }
+  aml << "</InternalElement></InstanceHierarchy><SystemUnitClassLib Name=\"Lib\">" << classes.str()
+      << "</SystemUnitClassLib></CAEXFile>\n";
+  std::ofstream(dir / "rings.aml") << aml.str();
+  return dir / "rings.aml";
+}
+
+// What a twin pays for the ring stack: loading (every file parsed, or read back from the
+// disk cache that an earlier order filled) and planning.
+void BM_RingStack(benchmark::State& state, bool cached) {
+  const auto file = ring_stack(static_cast<int>(state.range(0)));
+  const auto disk = file.parent_path() / "cache";
+  if (cached) {
+    sim::MeshCache earlier_order(disk);
+    twin::load_product(file, earlier_order);
+  }
+  std::size_t triangles = 0;
+  for (auto _ : state) {
+    if (!cached) {
+      state.PauseTiming();
+      std::filesystem::remove_all(disk);
+      state.ResumeTiming();
+    }
+    sim::MeshCache cache(disk);
+    const twin::LoadedProduct loaded = twin::load_product(file, cache);
+    auto s = twin::make_sequence_planner("search");
+    auto p = twin::make_path_planner("linear");
+    const twin::Plan plan = twin::plan_assembly(loaded, *s, *p);
+    if (!plan.complete) state.SkipWithError("plan incomplete");
+    triangles = loaded.meshes[0]->triangles.size();
+  }
+  state.counters["triangles/part"] = static_cast<double>(triangles);
+  std::filesystem::remove_all(file.parent_path());
+}
+
 // One swept check: a Cranfield peg down through its hole, 200 mm.
 void BM_PegSweep(benchmark::State& state) {
   sim::MeshCache cache;
@@ -88,5 +169,9 @@ BENCHMARK_CAPTURE(BM_Wall, search, std::string("search"))->Arg(10)->Arg(100)->Ar
 BENCHMARK_CAPTURE(BM_Tower, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Tower, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PegSweep)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_RingStack, first, false)->Arg(1000)->Arg(10000)->Arg(50000)->Arg(100000)->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_RingStack, cached, true)->Arg(1000)->Arg(10000)->Arg(50000)->Arg(100000)->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

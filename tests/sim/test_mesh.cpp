@@ -1,5 +1,9 @@
 #include <catch2/catch.hpp>
 
+#include <fstream>
+#include <unistd.h>
+
+#include "sim/mesh/mesh_disk_cache.hpp"
 #include "sim/mesh/triangle_mesh.hpp"
 
 namespace {
@@ -84,4 +88,43 @@ TEST_CASE("flipped normals: triangles wound against their neighbours, or a piece
   CHECK(inside_out->repairs.flipped == 12);
   CHECK(volume(*inside_out) == Approx(8e-6));
   CHECK(inside_out->convex);
+}
+
+TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores a broken entry", "[mesh][cache]") {
+  const auto folder = std::filesystem::temp_directory_path() / ("mesh-cache-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(folder);
+  const auto file = data("planning/messy/meshes/flipped_block_mm.obj");
+  const auto loaded = sim::load_mesh(file, 1e-3);
+  const auto same = [&](const sim::TriangleMesh& m) {
+    CHECK(m.vertices == loaded->vertices);
+    CHECK(m.triangles == loaded->triangles);
+    CHECK(m.pieces == loaded->pieces);
+    CHECK(m.bounds.isApprox(loaded->bounds));
+    CHECK(m.convex == loaded->convex);
+    CHECK(m.repairs.describe() == loaded->repairs.describe());
+  };
+  same(*sim::MeshCache(folder).get(file, 1e-3));  // loaded and written
+  REQUIRE(std::distance(std::filesystem::directory_iterator(folder), {}) == 1);
+  const auto entry = std::filesystem::directory_iterator(folder)->path();
+  same(*sim::MeshDiskCache(folder).load(file, 1e-3));  // read back
+
+  // Another scale is another entry; so is another content.
+  sim::MeshCache(folder).get(file, 1.0);
+  sim::MeshCache(folder).get(data("planning/messy/meshes/inside_out_block_mm.obj"), 1e-3);
+  CHECK(std::distance(std::filesystem::directory_iterator(folder), {}) == 3);
+
+  // A cut entry is not used: the mesh is loaded again and the entry written whole.
+  const auto whole = std::filesystem::file_size(entry);
+  std::filesystem::resize_file(entry, whole / 2);
+  same(*sim::MeshDiskCache(folder).load(file, 1e-3));
+  CHECK(std::filesystem::file_size(entry) == whole);
+  // So is one whose triangles name vertices it does not have.
+  {
+    std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(8 + 4 + 8 + 8 * 3 * 8 + 8);  // magic, version, vertex count, 8 vertices, triangle count
+    const std::uint32_t far = 1000;
+    f.write(reinterpret_cast<const char*>(&far), sizeof far);
+  }
+  same(*sim::MeshDiskCache(folder).load(file, 1e-3));
+  std::filesystem::remove_all(folder);
 }

@@ -1,0 +1,156 @@
+#include "sim/mesh/mesh_disk_cache.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <unistd.h>
+
+namespace sim {
+namespace {
+
+constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
+// Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
+constexpr std::uint32_t kVersion = 1;
+
+// FNV-1a, 64 bits: stable across runs and builds, which std::hash is not.
+std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665603ULL) {
+  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+
+template <class T>
+void put(std::ostream& out, const T& value) {
+  out.write(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+template <class T>
+bool get(std::istream& in, T& value) {
+  return static_cast<bool>(in.read(reinterpret_cast<char*>(&value), sizeof value));
+}
+
+void write_entry(const std::filesystem::path& path, const TriangleMesh& m) {
+  std::filesystem::create_directories(path.parent_path());
+  static std::atomic<unsigned> written{0};  // two threads of a process write apart too
+  const auto temporary = path.string() + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(++written);
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    put(out, kMagic);
+    put(out, kVersion);
+    put(out, static_cast<std::uint64_t>(m.vertices.size()));
+    for (const auto& v : m.vertices) put(out, v);
+    put(out, static_cast<std::uint64_t>(m.triangles.size()));
+    for (const auto& t : m.triangles) put(out, t);
+    put(out, static_cast<std::uint64_t>(m.pieces.size()));
+    for (const auto& piece : m.pieces) {
+      put(out, static_cast<std::uint64_t>(piece.size()));
+      out.write(reinterpret_cast<const char*>(piece.data()), static_cast<std::streamsize>(piece.size() * sizeof piece[0]));
+    }
+    put(out, m.bounds.min());
+    put(out, m.bounds.max());
+    put(out, static_cast<std::uint8_t>(m.convex));
+    for (std::size_t n : {m.repairs.degenerate, m.repairs.duplicate, m.repairs.flipped, m.repairs.open_edges,
+                          m.repairs.non_manifold_edges}) {
+      put(out, static_cast<std::uint64_t>(n));
+    }
+    if (!out) {
+      std::filesystem::remove(temporary);
+      return;
+    }
+  }
+  std::filesystem::rename(temporary, path);  // whole or not at all
+}
+
+// The entry, or nothing when it is missing or not one this version wrote whole.
+std::shared_ptr<TriangleMesh> read_entry(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return nullptr;
+  const auto size = std::filesystem::file_size(path);
+  std::uint64_t magic = 0, n = 0;
+  std::uint32_t version = 0;
+  if (!get(in, magic) || magic != kMagic || !get(in, version) || version != kVersion) return nullptr;
+  auto m = std::make_shared<TriangleMesh>();
+  const auto count = [&](std::size_t each) { return get(in, n) && n * each <= size; };
+  if (!count(sizeof(Eigen::Vector3d))) return nullptr;
+  m->vertices.resize(n);
+  for (auto& v : m->vertices) {
+    if (!get(in, v) || !v.allFinite()) return nullptr;
+  }
+  if (!count(sizeof(std::array<std::uint32_t, 3>))) return nullptr;
+  m->triangles.resize(n);
+  for (auto& t : m->triangles) {
+    if (!get(in, t) || t[0] >= m->vertices.size() || t[1] >= m->vertices.size() || t[2] >= m->vertices.size()) {
+      return nullptr;
+    }
+  }
+  if (!count(sizeof(std::uint64_t))) return nullptr;
+  m->pieces.resize(n);
+  for (auto& piece : m->pieces) {
+    if (!count(sizeof(std::uint32_t))) return nullptr;
+    piece.resize(n);
+    if (!in.read(reinterpret_cast<char*>(piece.data()), static_cast<std::streamsize>(n * sizeof(std::uint32_t)))) {
+      return nullptr;
+    }
+    for (std::uint32_t v : piece) {
+      if (v >= m->vertices.size()) return nullptr;
+    }
+  }
+  Eigen::Vector3d lo, hi;
+  std::uint8_t convex = 0;
+  if (!get(in, lo) || !get(in, hi) || !get(in, convex)) return nullptr;
+  m->bounds = Eigen::AlignedBox3d(lo, hi);
+  m->convex = convex != 0;
+  for (std::size_t* r : {&m->repairs.degenerate, &m->repairs.duplicate, &m->repairs.flipped, &m->repairs.open_edges,
+                         &m->repairs.non_manifold_edges}) {
+    if (!get(in, n)) return nullptr;
+    *r = n;
+  }
+  if (m->triangles.empty() || in.peek() != std::char_traits<char>::eof()) return nullptr;
+  return m;
+}
+
+}  // namespace
+
+std::optional<std::filesystem::path> MeshDiskCache::folder_from_environment() {
+  const auto env = [](const char* name) -> std::string {
+    const char* v = std::getenv(name);
+    return v ? v : "";
+  };
+  const std::string chosen = env("AGILE_CELL_MESH_CACHE");
+  if (chosen == "off") return std::nullopt;
+  if (!chosen.empty()) return std::filesystem::path(chosen);
+  if (!env("XDG_CACHE_HOME").empty()) return std::filesystem::path(env("XDG_CACHE_HOME")) / "agile-cell" / "meshes";
+  if (!env("HOME").empty()) return std::filesystem::path(env("HOME")) / ".cache" / "agile-cell" / "meshes";
+  return std::nullopt;
+}
+
+std::shared_ptr<const TriangleMesh> MeshDiskCache::load(const std::filesystem::path& file, double scale) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return load_mesh(file, scale);  // says why it cannot be read
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ostringstream name;
+  name << std::hex << fnv1a(file.extension().string(), fnv1a(bytes)) << '-' << std::hexfloat << scale;
+  std::string entry_name = name.str();
+  for (char& c : entry_name) {
+    if (c == '+' || c == '.') c = '_';
+  }
+  const auto entry = folder_ / (entry_name + ".mesh");
+  std::error_code ignored;
+  try {
+    if (auto cached = read_entry(entry)) return cached;
+  } catch (const std::exception&) {
+    // unreadable: loaded and written anew below
+  }
+  auto mesh = load_mesh(file, scale);
+  try {
+    write_entry(entry, *mesh);
+  } catch (const std::exception&) {
+    std::filesystem::remove(entry, ignored);  // a cache that cannot be written is no cache
+  }
+  return mesh;
+}
+
+}  // namespace sim
