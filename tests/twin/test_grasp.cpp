@@ -14,6 +14,11 @@ twin::Pose at(const Vec3& position) {
   return p;
 }
 
+twin::Plan plan_of(const twin::LoadedProduct& loaded, const twin::PlannerOptions& options = {}) {
+  twin::SearchSequencePlanner sequence;
+  return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"), options);
+}
+
 bool has_finding(const twin::Plan& plan, const std::string& kind, const std::string& text) {
   for (const auto& f : plan.findings) {
     if (f.kind == kind && f.message.find(text) != std::string::npos) return true;
@@ -61,9 +66,7 @@ TEST_CASE("grasps: behind the push first, the narrower faces first, never ahead 
 TEST_CASE("grasps: a bushing beside a tall panel is held from the side away from it", "[planning][grasp]") {
   sim::MeshCache cache;
   const auto loaded = twin::load_product(test::data("planning/grasp/grasp.aml"), cache);
-  twin::SearchSequencePlanner sequence;
-  const auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(loaded, sequence, *path);
+  const twin::Plan plan = plan_of(loaded);
   REQUIRE(plan.complete);
   REQUIRE(plan.steps.size() == 2);
   const auto& step = plan.steps[1];
@@ -99,9 +102,7 @@ TEST_CASE("grasps: a bushing beside a tall panel is held from the side away from
 TEST_CASE("grasps: a part no grasp takes is reported with what the gripper hit", "[planning][grasp]") {
   sim::MeshCache cache;
   const auto loaded = twin::load_product(test::data("planning/grasp/wide-sheet.aml"), cache);
-  twin::SearchSequencePlanner sequence;
-  const auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(loaded, sequence, *path);
+  const twin::Plan plan = plan_of(loaded);
   CHECK_FALSE(plan.complete);
   CHECK(has_finding(plan, "infeasible", "sheet: no collision-free path; the gripper hit station on every grasp"));
 }
@@ -109,11 +110,9 @@ TEST_CASE("grasps: a part no grasp takes is reported with what the gripper hit",
 TEST_CASE("grasps: a smaller gripper from the deployment file leaves a part it cannot open around", "[planning][grasp]") {
   sim::MeshCache cache;
   const auto loaded = twin::load_product(test::data("planning/grasp/grasp.aml"), cache);
-  twin::SearchSequencePlanner sequence;
-  const auto path = twin::make_path_planner("linear");
   twin::PlannerOptions options;
   options.gripper.max_opening = 0.012;  // the panel (4 mm) fits, the bushing (16 mm) does not
-  const twin::Plan plan = twin::plan_assembly(loaded, sequence, *path, options);
+  const twin::Plan plan = plan_of(loaded, options);
   CHECK_FALSE(plan.complete);
   CHECK(has_finding(plan, "infeasible", "bushing: no grasp: it is 16.00 mm across at its narrowest, 4.00 mm more than the gripper opens"));
 }
