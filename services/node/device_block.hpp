@@ -12,7 +12,7 @@
 //                                           never accepted, see below
 //   A command is checked before it is accepted: its fields (finite numbers, unit quaternions,
 //   positions inside the cell's bounds, texts and paths within limits, and what the device
-//   itself needs: an arm's grip pad above 0 in size), then whether its order may command the
+//   itself needs: an arm's grip opening within its gripper), then whether its order may command the
 //   resource (`authorize`: it holds the award the command names). A command that fails is
 //   REFUSEd with the reason, never queued or started.
 //   A command that comes again (its sender heard nothing of it: a DDS match that was not

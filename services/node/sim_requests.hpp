@@ -46,7 +46,7 @@ class SimRequests {
 namespace fb {
 
 // A move's reply as what a device reports: DONE data (sim_time, distance, duration), or, in
-// `failure`, why it failed ("collision of arm-1/pad with B6, 1.2 mm deep").
+// `failure`, why it failed ("collision of arm-1/palm with B6, 1.2 mm deep").
 Data move_outcome(const Data& reply, std::string& failure);
 
 }  // namespace fb

@@ -452,7 +452,7 @@ void OrderOrchestrator::back_to_sequence_planning() {
   next_action();
 }
 
-// Grip, move along the pads' poses while holding, release, back out, connect.
+// Grip, move along the gripper's poses while holding, release, back out, connect.
 void OrderOrchestrator::add_arm_moves(const std::string& body, const std::vector<Pose>& holding,
                                       const std::vector<Pose>& retreat) {
   const bool turns = std::any_of(holding.begin(), holding.end(),
