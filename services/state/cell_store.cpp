@@ -1,6 +1,8 @@
 #include "services/state/cell_store.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <thread>
 
 namespace state {
 namespace {
@@ -135,16 +137,31 @@ CellStore::CellStore(const std::filesystem::path& dir) {
   }
   // Several processes write: a writer waits for another's short transaction rather than fail.
   sqlite3_busy_timeout(db_, 10000);
-  try {
-    exec("PRAGMA journal_mode=WAL");
-    exec("PRAGMA synchronous=FULL");
-    exec("PRAGMA foreign_keys=ON");
-    Transaction t(*this);
-    exec(kSchema);
-    t.commit();
-  } catch (...) {
-    sqlite3_close(db_);
-    throw;
+  // Setting up can still meet "database is locked" at once, without the busy handler (the
+  // switch to WAL while the cell's processes open the database together, on a loaded
+  // machine: a mobile robot died of it): tried again for up to 10 s.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  for (int attempt = 1;; ++attempt) {
+    try {
+      exec("PRAGMA journal_mode=WAL");
+      exec("PRAGMA synchronous=FULL");
+      exec("PRAGMA foreign_keys=ON");
+      Transaction t(*this);
+      exec(kSchema);
+      t.commit();
+      return;
+    } catch (const StoreError&) {
+      const int code = sqlite3_errcode(db_) & 0xff;
+      if ((code == SQLITE_BUSY || code == SQLITE_LOCKED) && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(std::min(20 * attempt, 200)));
+        continue;
+      }
+      sqlite3_close(db_);
+      throw;
+    } catch (...) {
+      sqlite3_close(db_);
+      throw;
+    }
   }
 }
 
