@@ -48,12 +48,10 @@ void add_point(std::vector<std::string>& argv, const char* option, const Point& 
   for (double v : p) argv.push_back(std::to_string(v));
 }
 
-// --gripper-finger-length M, ...: as services/dds/cli_options.hpp reads them.
+// --gripper-finger-length M, ...: as add_gripper_options (services/dds/cli_options.hpp) reads them.
 void add_gripper(std::vector<std::string>& argv, const fb::GripperGeometry& gripper) {
   for (const auto& [name, size] : fb::gripper_sizes()) {
-    std::string flag = "--gripper-" + name;
-    std::replace(flag.begin(), flag.end(), '_', '-');
-    argv.insert(argv.end(), {flag, std::to_string(gripper.*size)});
+    argv.insert(argv.end(), {fb::gripper_option(name), std::to_string(gripper.*size)});
   }
 }
 

@@ -4,8 +4,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
-
 #include "services/blocks/sample_checks.hpp"
 #include "services/node/gripper.hpp"
 #include "services/dds/participant.hpp"
@@ -33,9 +31,7 @@ inline void add_state_option(CLI::App& app, std::string& state_dir) {
 // --gripper-finger-length M, ...: the arm's gripper (deployment key `gripper:`).
 inline void add_gripper_options(CLI::App& app, fb::GripperGeometry& gripper) {
   for (const auto& [name, size] : fb::gripper_sizes()) {
-    std::string flag = "--gripper-" + name;
-    std::replace(flag.begin(), flag.end(), '_', '-');
-    app.add_option(flag, gripper.*size, "The gripper's " + name + ", m (services/node/gripper.hpp)")
+    app.add_option(fb::gripper_option(name), gripper.*size, "The gripper's " + name + ", m (services/node/gripper.hpp)")
         ->check(CLI::PositiveNumber);
   }
 }

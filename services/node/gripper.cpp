@@ -1,5 +1,6 @@
 #include "services/node/gripper.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fb {
@@ -12,6 +13,12 @@ const std::vector<std::pair<std::string, double GripperGeometry::*>>& gripper_si
       {"max_opening", &G::max_opening},     {"carriage_width", &G::carriage_width},
       {"carriage_length", &G::carriage_length}};
   return all;
+}
+
+std::string gripper_option(const std::string& size_name) {
+  std::string flag = "--gripper-" + size_name;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
 }
 
 std::string GripperGeometry::problem() const {

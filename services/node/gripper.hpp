@@ -32,6 +32,8 @@ struct GripperGeometry {
 // Its sizes by name, as the deployment file's `gripper:` spells them (the command lines
 // take them as --gripper-<name with dashes>).
 const std::vector<std::pair<std::string, double GripperGeometry::*>>& gripper_sizes();
+// "finger_length" -> "--gripper-finger-length": the option a process takes it by.
+std::string gripper_option(const std::string& size_name);
 
 struct GripperBox {
   std::string name;          // "finger-1", "finger-2", "palm", "carriage"
