@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
@@ -106,6 +107,48 @@ class Writer : private fdds::DataWriterListener {
   int matched_ = 0;
   std::chrono::steady_clock::time_point matched_at_ = std::chrono::steady_clock::now();
   bool closed_ = false;
+};
+
+// A writer whose samples come late rather than never while a reader is slow for a while.
+// A reliable KEEP_ALL writer whose readers have not acknowledged `max_queued` samples waits
+// max_blocking_time for room and then fails the write: under a flood, beside a reader starved
+// of CPU, a command's final event was lost so. The outbox keeps such samples, in order, and
+// writes them again before its next sample and on flush(). Bounded: past `capacity` kept
+// samples it refuses more. Thread-safe.
+template <class T, class PubSubType>
+class Outbox {
+ public:
+  Outbox(ParticipantPtr participant, const std::string& topic, TopicKind kind, const QosSettings& settings = {},
+         std::size_t capacity = 4096)
+      : writer_(std::move(participant), topic, kind, settings), capacity_(capacity) {}
+
+  // True when the sample was written or is kept to be written; false when the outbox is full.
+  bool write(const T& sample) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    flush_locked();
+    if (kept_.empty() && writer_.write(sample)) return true;
+    if (kept_.size() >= capacity_) return false;
+    kept_.push_back(sample);
+    return true;
+  }
+  // Writes what was kept while there is room; the samples still kept.
+  std::size_t flush() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    flush_locked();
+    return kept_.size();
+  }
+
+  Writer<T, PubSubType>& writer() { return writer_; }
+
+ private:
+  void flush_locked() {
+    while (!kept_.empty() && writer_.write(kept_.front())) kept_.pop_front();
+  }
+
+  Writer<T, PubSubType> writer_;
+  std::size_t capacity_;
+  std::mutex mutex_;
+  std::deque<T> kept_;
 };
 
 template <class T, class PubSubType>

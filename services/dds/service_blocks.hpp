@@ -3,7 +3,8 @@
 // data and the topic's type is the block's only knowledge of the type, given by the
 // service that uses it; the runtime stays free of DDS.
 //
-//   PublishBlock:   REQ (data) -> writes one sample -> CNF, or ERROR (reason)
+//   PublishBlock:   REQ (data) -> writes one sample -> CNF, or ERROR (reason). A sample a
+//                   slow reader has no room for yet is kept and written when there is (Outbox).
 //   SubscribeBlock: a sample arrives -> IND (data); its writers are gone -> GONE (key data).
 //                   A mapping that returns no data drops the sample on the listener thread
 //                   (one meant for another resource never takes a place in this queue).
@@ -29,27 +30,29 @@ class PublishBlock : public fb::FunctionBlock {
 
   PublishBlock(std::string name, ParticipantPtr participant, const std::string& topic, TopicKind kind, ToSample to_sample)
       : FunctionBlock(std::move(name)),
-        writer_(std::make_unique<Writer<T, PubSubType>>(std::move(participant), topic, kind)),
+        writer_(std::make_unique<Outbox<T, PubSubType>>(std::move(participant), topic, kind)),
         to_sample_(std::move(to_sample)) {
     declare_input("REQ");
     declare_output("CNF");
     declare_output("ERROR", {"reason"});
   }
 
-  Writer<T, PubSubType>& writer() { return *writer_; }
+  Writer<T, PubSubType>& writer() { return writer_->writer(); }
+
+  void idle() override { writer_->flush(); }
 
   void receive(const fb::Event& event) override {
     if (event.name != "REQ") return;
     try {
       if (writer_->write(to_sample_(event.data))) return emit("CNF");
-      emit("ERROR", {{"reason", std::string("DDS write failed on ") + name()}});
+      emit("ERROR", {{"reason", name() + ": its readers have not taken the samples kept for them"}});
     } catch (const std::exception& e) {  // data that does not fit the type (a text too long)
       emit("ERROR", {{"reason", name() + ": " + e.what()}});
     }
   }
 
  private:
-  std::unique_ptr<Writer<T, PubSubType>> writer_;
+  std::unique_ptr<Outbox<T, PubSubType>> writer_;
   ToSample to_sample_;
 };
 

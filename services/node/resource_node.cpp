@@ -80,7 +80,7 @@ struct ResourceNode::Impl {
   dds::SimClock clock;
   std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
   // Answers to commands the resource's queue had no room for, written on the listener thread.
-  std::unique_ptr<dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>> overflow_answers;
+  std::unique_ptr<dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType>> overflow_answers;
   std::atomic<std::size_t> overflowed{0};
   std::size_t overflowed_published = 0;  // resource thread only
   std::mutex refusal_mutex;
@@ -169,7 +169,7 @@ struct ResourceNode::Impl {
     if (interrupted.empty()) return;
     // An event nobody hears is lost: the readers already there (the commanders' among them)
     // are given time to match.
-    overflow_answers->wait_for_settled_readers(std::chrono::milliseconds(500), std::chrono::seconds(3));
+    overflow_answers->writer().wait_for_settled_readers(std::chrono::milliseconds(500), std::chrono::seconds(3));
     for (const auto& c : interrupted) {
       const bool concerned = !c.part.empty() && recovered.find(c.part) != std::string::npos;
       const std::string reason = fb::restarted_reason(config.id) + (concerned ? "; " + recovered : "");
@@ -260,7 +260,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
       "commands", dds::command_topic(me), TopicKind::events,
       [me](const cell::Command& c) { return c.resource_id().to_string() == me ? dds::to_data(c) : fb::Data{}; },
       dds::command_qos());
-  n.overflow_answers = std::make_unique<dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>>(
+  n.overflow_answers = std::make_unique<dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType>>(
       participant, "cell/command_events", TopicKind::events);
   commands.on_refused([&n](const cell::Command& c, const std::string& why) {
     cell::CommandEvent e;
@@ -280,6 +280,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.connect("commands", "IND", dev, "COMMAND");
   // Refusals counted on the listener thread while the queue was full, published once it is quiet.
   resource.on_idle([&n] {
+    n.overflow_answers->flush();
     if (n.overflowed != n.overflowed_published) n.publish_capability();
     // Now and then: has a suspended order ended, or waited too long for its twin?
     const auto now = std::chrono::steady_clock::now();

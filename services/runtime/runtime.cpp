@@ -168,6 +168,14 @@ bool Resource::wait_and_run_one(std::chrono::milliseconds timeout) {
     if (!ready) idle = idle_;
   }
   if (ready) return run_one();
+  for (auto& [name, block] : blocks_) {
+    try {
+      block->idle();
+    } catch (const std::exception& e) {
+      ++failed_;
+      std::cerr << "error: " << name_ << ": " << name << " when idle: " << e.what() << '\n';
+    }
+  }
   if (idle) idle();
   return false;
 }

@@ -2,7 +2,12 @@
 // case has a domain id of its own, participants are localhost-only, and every wait is
 // bounded.
 
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
 #include <catch2/catch.hpp>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
@@ -99,4 +104,60 @@ TEST_CASE("state topics: a late reader sees the last state, and a dead writer is
   REQUIRE(run_until(resource, recorder, 2));
   CHECK(recorder.events[1].name == "GONE");
   CHECK(fb::get<std::string>(recorder.events[1].data, "resource_id") == "buffer-1");
+}
+
+TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers it all in order once it reads again",
+          "[dds]") {
+  // Between two participants of one process Fast DDS delivers on the writer's thread, into the
+  // reader's callback: the stalled reader would stall the writer, not fill its history.
+  struct OwnThreads {
+    eprosima::fastrtps::LibrarySettingsAttributes before = eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings();
+    OwnThreads() {
+      auto settings = before;
+      settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+      eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
+    }
+    ~OwnThreads() { eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(before); }
+  } own_threads;
+  const dds::ParticipantSettings settings{173, true};
+  auto station = dds::make_participant("test-station", settings);
+  auto twin = dds::make_participant("test-twin", settings);
+  dds::QosSettings small;
+  small.max_queued = 4;
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool stalled = true;
+  std::vector<std::string> got;
+  dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> reader(
+      twin, "cell/command_events", dds::TopicKind::events,
+      [&](const cell::CommandEvent& e) {
+        std::unique_lock<std::mutex> lock(mutex);
+        changed.wait_for(lock, std::chrono::seconds(20), [&] { return !stalled; });  // a reader starved of CPU
+        got.push_back(e.command_id().to_string());
+        changed.notify_all();
+      },
+      {}, small);
+  dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType> outbox(station, "cell/command_events",
+                                                                      dds::TopicKind::events, small);
+  REQUIRE(outbox.writer().wait_for_readers(1, std::chrono::seconds(10)));
+
+  std::vector<std::string> sent;
+  for (int i = 0; i < 16; ++i) {
+    sent.push_back("c-" + std::to_string(i));
+    CHECK(outbox.write(to_event({{"command_id", sent.back()}, {"t", 1.0}})));
+  }
+  // The writer alone would have failed these writes: its readers acknowledged no more.
+  CHECK(outbox.flush() > 0);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    stalled = false;
+    changed.notify_all();
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (outbox.flush() > 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::unique_lock<std::mutex> lock(mutex);
+  CHECK(changed.wait_for(lock, std::chrono::seconds(20), [&] { return got.size() >= sent.size(); }));
+  CHECK(got == sent);
 }
