@@ -25,6 +25,17 @@ btTransform to_bullet(const Pose& pose) {
                      to_bullet(Eigen::Vector3d(pose.translation())));
 }
 
+// The hull of a mesh's piece, of the corners loading found (mesh.hull_corners): a bore's or
+// a stud's inner vertices would only slow every support query of GJK.
+std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t piece, double margin) {
+  const auto& points = piece < mesh.hull_corners.size() ? mesh.hull_corners[piece] : mesh.pieces[piece];
+  auto hull = std::make_unique<btConvexHullShape>();
+  for (auto index : points) hull->addPoint(to_bullet(mesh.vertices[index]), false);
+  hull->recalcLocalAabb();
+  hull->setMargin(margin * kUnitsPerMetre);
+  return hull;
+}
+
 }  // namespace
 
 // --- MovingBody ---------------------------------------------------------------------------
@@ -80,15 +91,9 @@ MovingBody::MovingBody(MovingBody&& other) noexcept = default;
 MovingBody& MovingBody::operator=(MovingBody&& other) noexcept = default;
 
 void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin) {
-  for (const auto& piece : mesh.pieces) {
-    auto hull = std::make_unique<btConvexHullShape>();
-    for (auto index : piece) {
-      const Eigen::Vector3d& v = mesh.vertices[index];
-      hull->addPoint(to_bullet(v), false);
-      radius_ = std::max(radius_, (offset * v).norm());
-    }
-    hull->recalcLocalAabb();
-    hull->setMargin(margin * kUnitsPerMetre);
+  for (std::size_t piece = 0; piece < mesh.pieces.size(); ++piece) {
+    for (auto index : mesh.pieces[piece]) radius_ = std::max(radius_, (offset * mesh.vertices[index]).norm());
+    auto hull = hull_of(mesh, piece, margin);
     if (mesh.pieces.size() > 1 || mesh.convex) {  // convex pieces, or convex: the hull is exact
       impl_->add(member, std::move(hull), offset);
       continue;
@@ -125,8 +130,18 @@ Pose interpolate(const Pose& from, const Pose& to, double s) {
 
 // --- CollisionWorld -----------------------------------------------------------------------
 
+// Bullet's default pools (4096 manifolds and algorithms, some 7 MB, zeroed) cost more to set
+// up than a plan of a small product; a check of one moving body needs a few, and Bullet
+// allocates past its pool when it must.
+btDefaultCollisionConstructionInfo small_pools() {
+  btDefaultCollisionConstructionInfo info;
+  info.m_defaultMaxPersistentManifoldPoolSize = 256;
+  info.m_defaultMaxCollisionAlgorithmPoolSize = 256;
+  return info;
+}
+
 struct CollisionWorld::Impl {
-  btDefaultCollisionConfiguration configuration;
+  btDefaultCollisionConfiguration configuration{small_pools()};
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;
   btCollisionWorld world{&dispatcher, &broadphase, &configuration};
@@ -149,20 +164,18 @@ struct CollisionWorld::Impl {
   BodyId next_id = 0;
 
   // A mesh authored as convex pieces becomes a compound of their hulls: holes stay open and
-  // penetration depths are those of convex pairs. A one-piece mesh may be concave, so it
-  // becomes a triangle BVH (whose depths are per triangle, less exact for thin walls).
+  // penetration depths are those of convex pairs; a convex one-piece mesh is its hull, exact.
+  // Another one-piece mesh may be concave, so it becomes a triangle BVH (whose depths are per
+  // triangle, less exact for thin walls, and which costs a GJK per triangle near contact).
   btCollisionShape* static_shape_for(std::shared_ptr<const TriangleMesh> mesh, double margin) {
     auto [it, inserted] = meshes.try_emplace(mesh.get());
     SharedMesh& shared = it->second;
     if (!inserted) return shared.shape.get();
     shared.mesh = mesh;
-    if (mesh->pieces.size() > 1) {
+    if (mesh->pieces.size() > 1 || mesh->convex) {
       auto compound = std::make_unique<btCompoundShape>(true, static_cast<int>(mesh->pieces.size()));
-      for (const auto& piece : mesh->pieces) {
-        auto hull = std::make_unique<btConvexHullShape>();
-        for (auto index : piece) hull->addPoint(to_bullet(mesh->vertices[index]), false);
-        hull->recalcLocalAabb();
-        hull->setMargin(margin * kUnitsPerMetre);
+      for (std::size_t piece = 0; piece < mesh->pieces.size(); ++piece) {
+        auto hull = hull_of(*mesh, piece, margin);
         compound->addChildShape(btTransform::getIdentity(), hull.get());
         shared.hulls.push_back(std::move(hull));
       }
@@ -280,14 +293,52 @@ struct AnyOverlap : btBroadphaseAabbCallback {
 
 }  // namespace
 
+// The volume that the coarse body sweeps while it moves by `shift` (in its own frame) without
+// turning: each convex child's points and the same points shifted, whose hull is exactly the
+// child's swept volume. It holds the body at every pose of the move, so it reaches at least
+// as deep as any of them: when it is clear, so is the whole move.
+bool CollisionWorld::clear_translation(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift) const {
+  const btCompoundShape& coarse = body.impl_->coarse.compound;
+  const btVector3 d = to_bullet(shift);
+  btCompoundShape swept(true, coarse.getNumChildShapes());
+  std::vector<std::unique_ptr<btConvexHullShape>> hulls;
+  for (int i = 0; i < coarse.getNumChildShapes(); ++i) {
+    // Boxes and hulls, whose vertices leave the margin out, as the hull's own margin does.
+    const auto& child = static_cast<const btPolyhedralConvexShape&>(*coarse.getChildShape(i));
+    const btTransform& offset = coarse.getChildTransform(i);
+    auto hull = std::make_unique<btConvexHullShape>();
+    for (int v = 0; v < child.getNumVertices(); ++v) {
+      btVector3 p;
+      child.getVertex(v, p);
+      hull->addPoint(offset * p, false);
+      hull->addPoint(offset * p + d, false);
+    }
+    hull->recalcLocalAabb();
+    hull->setMargin(child.getMargin());
+    swept.addChildShape(btTransform::getIdentity(), hull.get());
+    hulls.push_back(std::move(hull));
+  }
+  btCollisionObject object;
+  object.setCollisionShape(&swept);
+  object.setWorldTransform(to_bullet(from));
+  DeepestContact callback(&object, options_.contact_tolerance);
+  ++checks_;
+  impl_->world.contactTest(&object, callback);
+  return !callback.deepest;
+}
+
 // Recursive: a stretch of the sweep whose bounding box (both ends, padded for turning)
-// overlaps no body is free as a whole; the rest is halved down to linear_step and sampled.
-// Samples go in order along the sweep, so the first collision is the one reported.
+// overlaps no body is free as a whole, and so is a stretch without turning whose swept volume
+// is clear; the rest is halved down to linear_step and sampled. Samples go in order along
+// the sweep, so the first collision is the one reported.
 std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose& from, const Pose& to) const {
   const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
   const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
   const btCollisionShape& shape = body.impl_->coarse.compound;
   const double pad = (angle * body.radius() + options_.shape_margin) * kUnitsPerMetre;
+  // Only for convex members: the hull of a concave one-piece member reaches into what it
+  // mates with (a brick's hull into the studs below), and its swept volume would only fail.
+  const bool translating = angle < 1e-9 && !body.impl_->has_exact;
 
   std::optional<Contact> hit;
   auto visit = [&](auto&& self, double s0, double s1, bool check_start) -> bool {
@@ -301,6 +352,10 @@ std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose&
     AnyOverlap overlap;
     impl_->broadphase.aabbTest(min_a - padding, max_a + padding, overlap);
     if (!overlap.found) return false;
+    const bool long_stretch = (s1 - s0) * travel > 16 * options_.linear_step;
+    if (translating && long_stretch && clear_translation(body, a, a.linear().transpose() * (b.translation() - a.translation()))) {
+      return false;
+    }
     if ((s1 - s0) * travel <= options_.linear_step) {
       for (auto [s, pose] : {std::pair{s0, a}, std::pair{s1, b}}) {
         if (s == s0 && !check_start) continue;

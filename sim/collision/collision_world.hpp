@@ -90,6 +90,8 @@ class CollisionWorld {
   std::size_t checks() const { return checks_; }
 
  private:
+  bool clear_translation(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   CollisionOptions options_;

@@ -14,7 +14,7 @@ namespace {
 
 constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
 
 // FNV-1a, 64 bits: stable across runs and builds, which std::hash is not.
 std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665603ULL) {
@@ -44,10 +44,12 @@ void write_entry(const std::filesystem::path& path, const TriangleMesh& m) {
     for (const auto& v : m.vertices) put(out, v);
     put(out, static_cast<std::uint64_t>(m.triangles.size()));
     for (const auto& t : m.triangles) put(out, t);
-    put(out, static_cast<std::uint64_t>(m.pieces.size()));
-    for (const auto& piece : m.pieces) {
-      put(out, static_cast<std::uint64_t>(piece.size()));
-      out.write(reinterpret_cast<const char*>(piece.data()), static_cast<std::streamsize>(piece.size() * sizeof piece[0]));
+    for (const auto* lists : {&m.pieces, &m.hull_corners}) {
+      put(out, static_cast<std::uint64_t>(lists->size()));
+      for (const auto& list : *lists) {
+        put(out, static_cast<std::uint64_t>(list.size()));
+        out.write(reinterpret_cast<const char*>(list.data()), static_cast<std::streamsize>(list.size() * sizeof list[0]));
+      }
     }
     put(out, m.bounds.min());
     put(out, m.bounds.max());
@@ -86,18 +88,21 @@ std::shared_ptr<TriangleMesh> read_entry(const std::filesystem::path& path) {
       return nullptr;
     }
   }
-  if (!count(sizeof(std::uint64_t))) return nullptr;
-  m->pieces.resize(n);
-  for (auto& piece : m->pieces) {
-    if (!count(sizeof(std::uint32_t))) return nullptr;
-    piece.resize(n);
-    if (!in.read(reinterpret_cast<char*>(piece.data()), static_cast<std::streamsize>(n * sizeof(std::uint32_t)))) {
-      return nullptr;
-    }
-    for (std::uint32_t v : piece) {
-      if (v >= m->vertices.size()) return nullptr;
+  for (auto* lists : {&m->pieces, &m->hull_corners}) {
+    if (!count(sizeof(std::uint64_t))) return nullptr;
+    lists->resize(n);
+    for (auto& list : *lists) {
+      if (!count(sizeof(std::uint32_t))) return nullptr;
+      list.resize(n);
+      if (!in.read(reinterpret_cast<char*>(list.data()), static_cast<std::streamsize>(n * sizeof(std::uint32_t)))) {
+        return nullptr;
+      }
+      for (std::uint32_t v : list) {
+        if (v >= m->vertices.size()) return nullptr;
+      }
     }
   }
+  if (m->hull_corners.size() != m->pieces.size()) return nullptr;
   Eigen::Vector3d lo, hi;
   std::uint8_t convex = 0;
   if (!get(in, lo) || !get(in, hi) || !get(in, convex)) return nullptr;

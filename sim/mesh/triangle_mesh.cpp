@@ -164,7 +164,27 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   repair(*mesh);
   if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds only degenerate triangles");
   mesh->convex = is_convex(*mesh);
+  mesh->hull_corners = hull_corners(*mesh);
   return mesh;
+}
+
+std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh) {
+  std::vector<std::vector<std::uint32_t>> out;
+  for (const auto& piece : mesh.pieces) {
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(piece.size());
+    for (auto index : piece) points.push_back(mesh.vertices[index]);
+    btConvexHullComputer hull;
+    if (!points.empty()) hull.compute(points.front().data(), sizeof(Eigen::Vector3d), static_cast<int>(points.size()), 0, 0);
+    std::vector<std::uint32_t> corners;
+    if (hull.vertices.size() >= 4) {
+      for (int i = 0; i < hull.original_vertex_index.size(); ++i) corners.push_back(piece[hull.original_vertex_index[i]]);
+    } else {
+      corners = piece;
+    }
+    out.push_back(std::move(corners));
+  }
+  return out;
 }
 
 bool is_convex(const TriangleMesh& mesh) {

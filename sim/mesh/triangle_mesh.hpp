@@ -21,6 +21,10 @@ struct TriangleMesh {
   // The file's objects (OBJ "o"/"g" groups, COLLADA geometries), each a list of vertex
   // indices. A mesh authored as a convex decomposition has one convex object per piece.
   std::vector<std::vector<std::uint32_t>> pieces;
+  // Per piece, the vertices on its convex hull (a subset of the piece's): the collision hulls
+  // are made of these, whose support queries then skip a bore's or a stud's inner vertices.
+  // Empty when not computed (a mesh made in code): the hulls take every vertex.
+  std::vector<std::vector<std::uint32_t>> hull_corners;
   Eigen::AlignedBox3d bounds;
   // One closed piece whose surface is its convex hull (a box, a pin): its hull is exact.
   // False for anything concave, open or inconsistently wound, which is the safe side.
@@ -40,6 +44,8 @@ struct TriangleMesh {
 
 // Whether the mesh is one closed convex piece: its volume is its hull's (to 0.1 %).
 bool is_convex(const TriangleMesh& mesh);
+// Each piece's vertices on its convex hull (all of them for a flat or degenerate piece).
+std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh);
 
 class MeshError : public std::runtime_error {
  public:

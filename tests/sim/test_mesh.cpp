@@ -1,7 +1,8 @@
-#include <catch2/catch.hpp>
-
 #include <fstream>
+#include <limits>
 #include <unistd.h>
+
+#include <catch2/catch.hpp>
 
 #include "sim/mesh/mesh_disk_cache.hpp"
 #include "sim/mesh/triangle_mesh.hpp"
@@ -30,6 +31,28 @@ TEST_CASE("a mesh's objects are kept apart as convex pieces", "[mesh]") {
   std::size_t vertices = 0;
   for (const auto& piece : faceplate->pieces) vertices += piece.size();
   CHECK(vertices == faceplate->vertices.size());
+}
+
+TEST_CASE("a piece's hull is made of its outer corners only", "[mesh]") {
+  // A bearing: a ring whose bore's vertices lie inside its hull.
+  const auto bearing = sim::load_mesh(data("planning/shaft-bearing/meshes/bearing.obj"), 1e-3);
+  REQUIRE(bearing->pieces.size() == 1);
+  REQUIRE(bearing->hull_corners.size() == 1);
+  const auto& corners = bearing->hull_corners[0];
+  CHECK(corners.size() < bearing->pieces[0].size());
+  const Eigen::Vector3d centre = bearing->bounds.center();
+  double inner = std::numeric_limits<double>::infinity();
+  for (auto v : bearing->pieces[0]) {
+    const Eigen::Vector3d d = bearing->vertices[v] - centre;
+    inner = std::min(inner, Eigen::Vector2d(d.x(), d.z()).norm());
+  }
+  for (auto v : corners) {
+    const Eigen::Vector3d d = bearing->vertices[v] - centre;
+    CHECK(Eigen::Vector2d(d.x(), d.z()).norm() > inner + 1e-4);  // none from the bore
+  }
+  // A box: all eight.
+  const auto block = sim::load_mesh(data("planning/messy/meshes/flipped_block_mm.obj"), 1e-3);
+  CHECK(block->hull_corners.at(0).size() == 8);
 }
 
 TEST_CASE("a file that is not a mesh is a MeshError", "[mesh]") {
@@ -99,6 +122,7 @@ TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores
     CHECK(m.vertices == loaded->vertices);
     CHECK(m.triangles == loaded->triangles);
     CHECK(m.pieces == loaded->pieces);
+    CHECK(m.hull_corners == loaded->hull_corners);
     CHECK(m.bounds.isApprox(loaded->bounds));
     CHECK(m.convex == loaded->convex);
     CHECK(m.repairs.describe() == loaded->repairs.describe());

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
@@ -137,15 +138,23 @@ InterferenceCheck find_interferences(const LoadedProduct& product, const sim::Co
   };
   // A convex part (or one authored as convex pieces) is a volume to Bullet: when its hull
   // reaches no deeper than the tolerance into the other part and does not lie wholly inside
-  // it, the two do not overlap, and the sampled check is spared (a peg in its hole).
+  // it, the two do not overlap, and the sampled check is spared (a peg in its hole). One
+  // world serves every pair: setting up a world costs more than a check.
+  std::optional<sim::CollisionWorld> world;
+  std::map<PartIndex, sim::MovingBody> moving_bodies;
+  const auto is_volume = [](const sim::TriangleMesh& mesh) { return mesh.convex || mesh.pieces.size() > 1; };
   const auto clear_to_bullet = [&](PartIndex moving, PartIndex fixed) {
     const sim::TriangleMesh& mesh = *product.meshes[moving];
-    if (!mesh.convex && mesh.pieces.size() < 2) return false;
-    sim::CollisionWorld world(options);
-    world.add_static_mesh(parts[fixed].name, product.meshes[fixed], parts[fixed].final_pose);
-    sim::MovingBody body;
-    body.add_mesh("part", mesh, Pose::Identity(), options.shape_margin);
-    if (world.penetration(body, parts[moving].final_pose)) return false;
+    if (!is_volume(mesh)) return false;
+    auto [body, fresh] = moving_bodies.try_emplace(moving);
+    if (fresh) body->second.add_mesh("part", mesh, Pose::Identity(), options.shape_margin);
+    if (!world) world.emplace(options);
+    const sim::BodyId other_body = world->add_static_mesh(parts[fixed].name, product.meshes[fixed], parts[fixed].final_pose);
+    const bool hit = world->penetration(body->second, parts[moving].final_pose).has_value();
+    world->remove(other_body);
+    if (hit) return false;
+    // Wholly inside a volume is a deep hit; inside a triangle surface is no contact at all.
+    if (is_volume(*product.meshes[fixed])) return true;
     const Solid& other = solid(fixed);
     if (!other.inside) return true;
     const Point corner = point(parts[fixed].final_pose.inverse() * (parts[moving].final_pose * mesh.vertices.front()));
