@@ -1,6 +1,7 @@
 #include "sim/collision/collision_world.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -42,8 +43,10 @@ std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t
 
 struct MovingBody::Impl {
   // `coarse`: every member convex (a one-piece mesh as its hull). `exact`: the same, but a
-  // one-piece mesh as its triangles, each a convex child; asked only where the coarse body
-  // penetrates, since the hull holds the mesh: where the hull does not reach, nothing does.
+  // one-piece concave mesh as its triangles, each a convex child; asked only where the coarse
+  // body penetrates, since the hull holds the mesh: where the hull does not reach, nothing
+  // does. It is made on the first such check: most bodies never need it, and a compound of
+  // 10k triangles costs more to make than a sweep.
   struct Shape {
     btCompoundShape compound{true};
     std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -56,20 +59,37 @@ struct MovingBody::Impl {
       shapes.push_back(std::move(shape));
     }
   };
-  Shape coarse, exact;
+  Shape coarse;
+  // Per coarse child, the triangles (in Bullet units) that stand for it in the exact body;
+  // empty for a convex child, which stands for itself.
+  std::vector<std::vector<std::array<btVector3, 3>>> triangles_of_child;
+  double margin = 0;  // of the triangles
   bool has_exact = false;
+  mutable std::unique_ptr<Shape> exact;
 
-  void add(const std::string& member, std::unique_ptr<btCollisionShape> shape, const Pose& offset) {
-    if (has_exact) exact.add(member, clone(*shape), to_bullet(offset));
-    coarse.add(member, std::move(shape), to_bullet(offset));
+  void add(const std::string& member, std::unique_ptr<btCollisionShape> shape, const btTransform& offset,
+           std::vector<std::array<btVector3, 3>> triangles = {}) {
+    has_exact = has_exact || !triangles.empty();
+    triangles_of_child.push_back(std::move(triangles));
+    coarse.add(member, std::move(shape), offset);
   }
-  // The exact body is made only once a concave member comes: until then it is the coarse one.
-  void begin_exact() {
-    if (has_exact) return;
+  Shape& exact_shape() const {
+    if (exact) return *exact;
+    exact = std::make_unique<Shape>();
     for (std::size_t i = 0; i < coarse.shapes.size(); ++i) {
-      exact.add(coarse.member_of_child[i], clone(*coarse.shapes[i]), coarse.compound.getChildTransform(static_cast<int>(i)));
+      const btTransform& offset = coarse.compound.getChildTransform(static_cast<int>(i));
+      const std::string& member = coarse.member_of_child[i];
+      if (triangles_of_child[i].empty()) {
+        exact->add(member, clone(*coarse.shapes[i]), offset);
+        continue;
+      }
+      for (const auto& t : triangles_of_child[i]) {
+        auto triangle = std::make_unique<btTriangleShape>(t[0], t[1], t[2]);
+        triangle->setMargin(margin);
+        exact->add(member, std::move(triangle), offset);
+      }
     }
-    has_exact = true;
+    return *exact;
   }
   static std::unique_ptr<btCollisionShape> clone(const btCollisionShape& shape) {
     if (shape.getShapeType() == BOX_SHAPE_PROXYTYPE) {
@@ -95,19 +115,25 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
     for (auto index : mesh.pieces[piece]) radius_ = std::max(radius_, (offset * mesh.vertices[index]).norm());
     auto hull = hull_of(mesh, piece, margin);
     if (mesh.pieces.size() > 1 || mesh.convex) {  // convex pieces, or convex: the hull is exact
-      impl_->add(member, std::move(hull), offset);
+      impl_->add(member, std::move(hull), to_bullet(offset));
       continue;
     }
     // One piece, maybe concave (a bracket, a housing with a bore): its hull is only the
-    // coarse test; the exact one goes by its triangles.
-    impl_->begin_exact();
-    impl_->coarse.add(member, std::move(hull), to_bullet(offset));
-    for (const auto& t : mesh.triangles) {
-      auto triangle = std::make_unique<btTriangleShape>(to_bullet(mesh.vertices[t[0]]), to_bullet(mesh.vertices[t[1]]),
-                                                        to_bullet(mesh.vertices[t[2]]));
-      triangle->setMargin(margin * kUnitsPerMetre);
-      impl_->exact.add(member, std::move(triangle), to_bullet(offset));
+    // coarse test, of few corners grown to hold the rest where loading made it so; the exact
+    // one goes by its triangles.
+    if (!mesh.coarse_corners.empty()) {
+      hull = std::make_unique<btConvexHullShape>();
+      for (auto index : mesh.coarse_corners) hull->addPoint(to_bullet(mesh.vertices[index]), false);
+      hull->recalcLocalAabb();
+      hull->setMargin((margin + mesh.coarse_margin) * kUnitsPerMetre);
     }
+    std::vector<std::array<btVector3, 3>> triangles;
+    triangles.reserve(mesh.triangles.size());
+    for (const auto& t : mesh.triangles) {
+      triangles.push_back({to_bullet(mesh.vertices[t[0]]), to_bullet(mesh.vertices[t[1]]), to_bullet(mesh.vertices[t[2]])});
+    }
+    impl_->margin = margin * kUnitsPerMetre;
+    impl_->add(member, std::move(hull), to_bullet(offset), std::move(triangles));
   }
 }
 
@@ -116,7 +142,7 @@ void MovingBody::add_box(const std::string& member, const Eigen::Vector3d& half_
   auto box = std::make_unique<btBoxShape>(to_bullet(half_extents));
   box->setMargin(margin * kUnitsPerMetre);
   radius_ = std::max(radius_, offset.translation().norm() + half_extents.norm());
-  impl_->add(member, std::move(box), offset);
+  impl_->add(member, std::move(box), to_bullet(offset));
 }
 
 bool MovingBody::empty() const { return impl_->coarse.shapes.empty(); }
@@ -278,7 +304,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   };
   auto contact = deepest(body.impl_->coarse);
   if (!contact || !body.impl_->has_exact) return contact;
-  return deepest(body.impl_->exact);
+  return deepest(body.impl_->exact_shape());
 }
 
 namespace {

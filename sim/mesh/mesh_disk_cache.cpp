@@ -1,6 +1,7 @@
 #include "sim/mesh/mesh_disk_cache.hpp"
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -14,7 +15,7 @@ namespace {
 
 constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
-constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kVersion = 3;
 
 // FNV-1a, 64 bits: stable across runs and builds, which std::hash is not.
 std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665603ULL) {
@@ -44,13 +45,15 @@ void write_entry(const std::filesystem::path& path, const TriangleMesh& m) {
     for (const auto& v : m.vertices) put(out, v);
     put(out, static_cast<std::uint64_t>(m.triangles.size()));
     for (const auto& t : m.triangles) put(out, t);
-    for (const auto* lists : {&m.pieces, &m.hull_corners}) {
+    const std::vector<std::vector<std::uint32_t>> coarse{m.coarse_corners};
+    for (const auto* lists : {&m.pieces, &m.hull_corners, &coarse}) {
       put(out, static_cast<std::uint64_t>(lists->size()));
       for (const auto& list : *lists) {
         put(out, static_cast<std::uint64_t>(list.size()));
         out.write(reinterpret_cast<const char*>(list.data()), static_cast<std::streamsize>(list.size() * sizeof list[0]));
       }
     }
+    put(out, m.coarse_margin);
     put(out, m.bounds.min());
     put(out, m.bounds.max());
     put(out, static_cast<std::uint8_t>(m.convex));
@@ -88,7 +91,8 @@ std::shared_ptr<TriangleMesh> read_entry(const std::filesystem::path& path) {
       return nullptr;
     }
   }
-  for (auto* lists : {&m->pieces, &m->hull_corners}) {
+  std::vector<std::vector<std::uint32_t>> coarse;
+  for (auto* lists : {&m->pieces, &m->hull_corners, &coarse}) {
     if (!count(sizeof(std::uint64_t))) return nullptr;
     lists->resize(n);
     for (auto& list : *lists) {
@@ -102,7 +106,9 @@ std::shared_ptr<TriangleMesh> read_entry(const std::filesystem::path& path) {
       }
     }
   }
-  if (m->hull_corners.size() != m->pieces.size()) return nullptr;
+  if (m->hull_corners.size() != m->pieces.size() || coarse.size() != 1) return nullptr;
+  m->coarse_corners = std::move(coarse.front());
+  if (!get(in, m->coarse_margin) || !std::isfinite(m->coarse_margin) || m->coarse_margin < 0) return nullptr;
   Eigen::Vector3d lo, hi;
   std::uint8_t convex = 0;
   if (!get(in, lo) || !get(in, hi) || !get(in, convex)) return nullptr;

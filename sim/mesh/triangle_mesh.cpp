@@ -2,9 +2,12 @@
 
 #include "sim/mesh/mesh_disk_cache.hpp"
 
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
 #include <LinearMath/btConvexHullComputer.h>
 
 #include <algorithm>
+#include <limits>
 #include <array>
 #include <cmath>
 #include <map>
@@ -165,7 +168,48 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds only degenerate triangles");
   mesh->convex = is_convex(*mesh);
   mesh->hull_corners = hull_corners(*mesh);
+  make_coarse_hull(*mesh);
   return mesh;
+}
+
+void make_coarse_hull(TriangleMesh& mesh) {
+  mesh.coarse_corners.clear();
+  mesh.coarse_margin = 0;
+  if (mesh.convex || mesh.pieces.size() != 1 || mesh.hull_corners.size() != 1) return;
+  const auto& corners = mesh.hull_corners[0];
+  if (corners.size() <= kCoarseCorners) return;
+  // Farthest-point sampling: each next corner the one farthest from those taken.
+  std::vector<double> nearest(corners.size(), std::numeric_limits<double>::infinity());
+  std::size_t next = 0;
+  for (std::size_t taken = 0; taken < kCoarseCorners; ++taken) {
+    mesh.coarse_corners.push_back(corners[next]);
+    const Eigen::Vector3d& p = mesh.vertices[corners[next]];
+    std::size_t farthest = 0;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+      nearest[i] = std::min(nearest[i], (mesh.vertices[corners[i]] - p).squaredNorm());
+      if (nearest[i] > nearest[farthest]) farthest = i;
+    }
+    next = farthest;
+  }
+  // How far the corners left out lie outside the hull of those taken (GJK, in millimetres,
+  // where Bullet's tolerances are meant for).
+  btConvexHullShape core;
+  for (auto index : mesh.coarse_corners) {
+    const Eigen::Vector3d p = mesh.vertices[index] * 1000;
+    core.addPoint(btVector3(p.x(), p.y(), p.z()), false);
+  }
+  core.recalcLocalAabb();
+  core.setMargin(0);
+  double outside = 0;
+  for (auto index : corners) {
+    const Eigen::Vector3d p = mesh.vertices[index] * 1000;
+    btGjkEpaSolver2::sResults result;
+    const double distance =
+        btGjkEpaSolver2::SignedDistance(btVector3(p.x(), p.y(), p.z()), 0, &core, btTransform::getIdentity(), result);
+    outside = std::max(outside, distance);
+  }
+  // A little over, for GJK's own tolerance.
+  mesh.coarse_margin = outside / 1000 * 1.01 + 1e-6;
 }
 
 std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh) {

@@ -25,6 +25,12 @@ struct TriangleMesh {
   // are made of these, whose support queries then skip a bore's or a stud's inner vertices.
   // Empty when not computed (a mesh made in code): the hulls take every vertex.
   std::vector<std::vector<std::uint32_t>> hull_corners;
+  // A concave one-piece mesh is checked by a coarse hull first and by its triangles only where
+  // that penetrates. The coarse hull: a few of its hull corners (kCoarseCorners at most, spread
+  // by farthest-point sampling), grown by `coarse_margin` (m) so that it holds every vertex.
+  // Empty for other meshes, or where the hull has few corners: then it is the hull itself.
+  std::vector<std::uint32_t> coarse_corners;
+  double coarse_margin = 0;
   Eigen::AlignedBox3d bounds;
   // One closed piece whose surface is its convex hull (a box, a pin): its hull is exact.
   // False for anything concave, open or inconsistently wound, which is the safe side.
@@ -46,6 +52,9 @@ struct TriangleMesh {
 bool is_convex(const TriangleMesh& mesh);
 // Each piece's vertices on its convex hull (all of them for a flat or degenerate piece).
 std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh);
+constexpr std::size_t kCoarseCorners = 256;
+// Fills coarse_corners and coarse_margin of a concave one-piece mesh whose hull_corners are set.
+void make_coarse_hull(TriangleMesh& mesh);
 
 class MeshError : public std::runtime_error {
  public:
