@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include <btBulletCollisionCommon.h>
 #include <BulletCollision/CollisionShapes/btTriangleShape.h>
@@ -36,6 +37,53 @@ std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t
   hull->setMargin(margin * kUnitsPerMetre);
   return hull;
 }
+
+// The coarse hull of a concave one-piece mesh (triangle_mesh.hpp): a few hull corners grown
+// to hold the rest, or the hull itself.
+std::unique_ptr<btConvexHullShape> coarse_hull_of(const TriangleMesh& mesh, double margin) {
+  if (mesh.coarse_corners.empty()) return hull_of(mesh, 0, margin);
+  auto hull = std::make_unique<btConvexHullShape>();
+  for (auto index : mesh.coarse_corners) hull->addPoint(to_bullet(mesh.vertices[index]), false);
+  hull->recalcLocalAabb();
+  hull->setMargin((margin + mesh.coarse_margin) * kUnitsPerMetre);
+  return hull;
+}
+
+constexpr int kCoarse = 1;  // user index 2 of a static body's hull that stands before its BVH
+
+// Keeps the deepest penetration beyond the tolerance, and which static bodies' coarse hulls
+// were penetrated beyond it (their exact shapes are asked next).
+struct DeepestContact : btCollisionWorld::ContactResultCallback {
+  const btCollisionObject* self;
+  double tolerance;
+  std::optional<Contact> deepest;
+  int self_child = -1;
+  std::set<BodyId> coarse_hits;
+
+  DeepestContact(const btCollisionObject* s, double t) : self(s), tolerance(t) {}
+
+  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper* a, int, int,
+                           const btCollisionObjectWrapper* b, int, int) override {
+    const double depth = -cp.getDistance() / kUnitsPerMetre;
+    if (depth <= tolerance) return 0;
+    const bool self_is_a = a->getCollisionObject() == self;
+    const btCollisionObject* other = self_is_a ? b->getCollisionObject() : a->getCollisionObject();
+    if (other->getUserIndex2() == kCoarse) {
+      coarse_hits.insert(other->getUserIndex());
+      return 0;
+    }
+    if (deepest && depth <= deepest->depth) return 0;
+    Contact c;
+    c.body = other->getUserIndex();
+    c.depth = depth;
+    const btVector3 p = self_is_a ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
+    c.point = Eigen::Vector3d(p.x(), p.y(), p.z()) / kUnitsPerMetre;
+    self_child = self_is_a ? a->m_index : b->m_index;
+    deepest = c;
+    return 0;
+  }
+};
+
 
 }  // namespace
 
@@ -121,12 +169,7 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
     // One piece, maybe concave (a bracket, a housing with a bore): its hull is only the
     // coarse test, of few corners grown to hold the rest where loading made it so; the exact
     // one goes by its triangles.
-    if (!mesh.coarse_corners.empty()) {
-      hull = std::make_unique<btConvexHullShape>();
-      for (auto index : mesh.coarse_corners) hull->addPoint(to_bullet(mesh.vertices[index]), false);
-      hull->recalcLocalAabb();
-      hull->setMargin((margin + mesh.coarse_margin) * kUnitsPerMetre);
-    }
+    hull = coarse_hull_of(mesh, margin);
     std::vector<std::array<btVector3, 3>> triangles;
     triangles.reserve(mesh.triangles.size());
     for (const auto& t : mesh.triangles) {
@@ -178,13 +221,18 @@ struct CollisionWorld::Impl {
     std::vector<int> indices;
     std::unique_ptr<btTriangleIndexVertexArray> array;
     std::unique_ptr<btCollisionShape> shape;
+    std::unique_ptr<btCollisionShape> coarse;  // a concave mesh's hull, asked before its BVH
     std::vector<std::unique_ptr<btCollisionShape>> hulls;
   };
   std::map<const TriangleMesh*, SharedMesh> meshes;
   struct Body {
     std::string name;
     std::unique_ptr<btCollisionShape> own_shape;  // boxes; meshes share theirs
-    std::unique_ptr<btCollisionObject> object;
+    std::unique_ptr<btCollisionObject> object;    // in the world
+    // A concave mesh's triangle BVH, outside the world: `object` is then its hull (user
+    // index 2 kCoarse), and only a body that penetrates that is checked against the BVH. A
+    // ring on the ring below touches thousands of triangles, and its hull not at all.
+    std::unique_ptr<btCollisionObject> exact;
   };
   std::map<BodyId, Body> bodies;
   BodyId next_id = 0;
@@ -219,49 +267,41 @@ struct CollisionWorld::Impl {
     auto bvh = std::make_unique<btBvhTriangleMeshShape>(shared.array.get(), true);
     bvh->setMargin(margin * kUnitsPerMetre);
     shared.shape = std::move(bvh);
+    shared.coarse = coarse_hull_of(*mesh, margin);
     return shared.shape.get();
   }
+  btCollisionShape* coarse_shape_of(const TriangleMesh* mesh) const {
+    const auto it = meshes.find(mesh);
+    return it == meshes.end() ? nullptr : it->second.coarse.get();
+  }
 
-  BodyId add(const std::string& name, btCollisionShape* shape, std::unique_ptr<btCollisionShape> own, const Pose& pose) {
-    auto object = std::make_unique<btCollisionObject>();
-    object->setCollisionShape(shape);
-    object->setWorldTransform(to_bullet(pose));
-    object->setUserIndex(next_id);
-    world.addCollisionObject(object.get());
-    bodies[next_id] = Body{name, std::move(own), std::move(object)};
+  // Every body the object penetrates, concave static ones by their hull first and by their
+  // triangles only where the hull is penetrated.
+  void contact_test(btCollisionObject& object, DeepestContact& callback) {
+    world.contactTest(&object, callback);
+    for (BodyId hit : callback.coarse_hits) world.contactPairTest(&object, bodies.at(hit).exact.get(), callback);
+  }
+
+  BodyId add(const std::string& name, btCollisionShape* shape, std::unique_ptr<btCollisionShape> own, const Pose& pose,
+             btCollisionShape* coarse = nullptr) {
+    const auto object_of = [&](btCollisionShape* s) {
+      auto object = std::make_unique<btCollisionObject>();
+      object->setCollisionShape(s);
+      object->setWorldTransform(to_bullet(pose));
+      object->setUserIndex(next_id);
+      return object;
+    };
+    Body body{name, std::move(own), object_of(coarse ? coarse : shape), nullptr};
+    if (coarse) {
+      body.object->setUserIndex2(kCoarse);
+      body.exact = object_of(shape);
+    }
+    world.addCollisionObject(body.object.get());
+    bodies[next_id] = std::move(body);
     return next_id++;
   }
 };
 
-namespace {
-
-// Keeps the deepest penetration beyond the tolerance.
-struct DeepestContact : btCollisionWorld::ContactResultCallback {
-  const btCollisionObject* self;
-  double tolerance;
-  std::optional<Contact> deepest;
-  int self_child = -1;
-
-  DeepestContact(const btCollisionObject* s, double t) : self(s), tolerance(t) {}
-
-  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper* a, int, int,
-                           const btCollisionObjectWrapper* b, int, int) override {
-    const double depth = -cp.getDistance() / kUnitsPerMetre;
-    if (depth <= tolerance || (deepest && depth <= deepest->depth)) return 0;
-    const bool self_is_a = a->getCollisionObject() == self;
-    const btCollisionObject* other = self_is_a ? b->getCollisionObject() : a->getCollisionObject();
-    Contact c;
-    c.body = other->getUserIndex();
-    c.depth = depth;
-    const btVector3 p = self_is_a ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
-    c.point = Eigen::Vector3d(p.x(), p.y(), p.z()) / kUnitsPerMetre;
-    self_child = self_is_a ? a->m_index : b->m_index;
-    deepest = c;
-    return 0;
-  }
-};
-
-}  // namespace
 
 CollisionWorld::CollisionWorld(CollisionOptions options) : impl_(std::make_unique<Impl>()), options_(options) {}
 CollisionWorld::~CollisionWorld() {
@@ -269,7 +309,8 @@ CollisionWorld::~CollisionWorld() {
 }
 
 BodyId CollisionWorld::add_static_mesh(const std::string& name, std::shared_ptr<const TriangleMesh> mesh, const Pose& pose) {
-  return impl_->add(name, impl_->static_shape_for(std::move(mesh), options_.shape_margin), nullptr, pose);
+  btCollisionShape* shape = impl_->static_shape_for(mesh, options_.shape_margin);
+  return impl_->add(name, shape, nullptr, pose, impl_->coarse_shape_of(mesh.get()));
 }
 
 BodyId CollisionWorld::add_static_box(const std::string& name, const Eigen::Vector3d& half_extents, const Pose& pose) {
@@ -292,7 +333,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
     btCollisionObject& object = shape.object;
     object.setWorldTransform(to_bullet(pose));
     DeepestContact callback(&object, options_.contact_tolerance);
-    impl_->world.contactTest(&object, callback);
+    impl_->contact_test(object, callback);
     if (!callback.deepest) return std::nullopt;
     Contact c = *callback.deepest;
     c.body_name = impl_->bodies.at(c.body).name;
@@ -349,7 +390,7 @@ bool CollisionWorld::clear_translation(const MovingBody& body, const Pose& from,
   object.setWorldTransform(to_bullet(from));
   DeepestContact callback(&object, options_.contact_tolerance);
   ++checks_;
-  impl_->world.contactTest(&object, callback);
+  impl_->contact_test(object, callback);
   return !callback.deepest;
 }
 
