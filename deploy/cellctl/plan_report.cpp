@@ -5,14 +5,22 @@
 namespace cellctl {
 
 void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostream& out) {
+  std::size_t placed = 0;
+  for (const auto& step : plan.steps) placed += step.carried.empty() ? 1 : 0;
   out << "Plan for '" << product.name() << "' (sequence: " << plan.sequence_planner << ", path: " << plan.path_planner
-      << "): " << (plan.complete ? "complete" : "INCOMPLETE") << ", " << plan.steps.size() << " of "
-      << product.parts().size() << " parts\n\n";
+      << "): " << (plan.complete ? "complete" : "INCOMPLETE") << ", " << placed << " of " << product.parts().size()
+      << " parts";
+  if (!plan.subassemblies.empty()) out << ", " << plan.subassemblies.size() << " subassembl" << (plan.subassemblies.size() == 1 ? "y" : "ies");
+  out << "\n\n";
+  // A subassembly's own steps read "ShaftPendulum: shaft", built aside; its insertion
+  // "ShaftPendulum (shaft, pendulum)".
   TextTable table({"step", "part", "type", "direction", "grasp", "path mm", "tries", "result"});
   for (std::size_t i = 0; i < plan.steps.size(); ++i) {
     const auto& step = plan.steps[i];
     const auto& part = product.parts()[step.part];
-    table.add_row({std::to_string(i + 1), part.name, twin::short_type_name(part.type), step.trajectory.label,
+    const bool inserts = !step.carried.empty();
+    const std::string name = inserts || step.subassembly.empty() ? twin::step_name(product, step) : step.subassembly + ": " + part.name;
+    table.add_row({std::to_string(i + 1), name, inserts ? "subassembly" : twin::short_type_name(part.type), step.trajectory.label,
                    step.trajectory.grasp.label + " (" + fixed(step.trajectory.grasp.opening * 1000, 1) + " mm)",
                    fixed(step.trajectory.path_length() * 1000, 1), std::to_string(step.failed.size() + 1),
                    step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)"});

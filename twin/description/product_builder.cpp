@@ -16,6 +16,7 @@ struct ItemApplier {
     part.orientation = item.orientation;
     part.mesh = item.mesh;
     part.own_interfaces = item.interfaces;
+    part.subassembly = item.subassembly;
     part.where = item.where;
     product.add_part(std::move(part));
   }

@@ -24,6 +24,7 @@ struct CreatePartItem {
   Quat orientation = Quat::Identity();
   std::optional<MeshRef> mesh;
   InterfaceMap interfaces;  // declared on the instance itself
+  std::string subassembly;  // the subassembly it belongs to; empty when it goes in alone
   SourceRef where;
 };
 

@@ -43,6 +43,9 @@ struct DigitalPart {
   Quat orientation = Quat::Identity();  // in the finished product
   std::optional<MeshRef> mesh;
   InterfaceMap own_interfaces;  // declared on the instance; override the type's
+  // The subassembly it belongs to (docs/automationml.md): built first with the other parts of
+  // that name, then inserted with them as one rigid body. Empty: it goes in alone.
+  std::string subassembly;
   SourceRef where;
 
   Pose final_pose = Pose::Identity();  // set by placement (twin/geometry/placement.hpp)

@@ -1,11 +1,13 @@
 #include "twin/planning/assembly_planner.hpp"
 
 #include "twin/planning/interference.hpp"
+#include "twin/planning/subassembly_planner.hpp"
 
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
+#include <stdexcept>
 #include <unordered_set>
 
 namespace twin {
@@ -87,7 +89,7 @@ class Search {
       }
       assembled_[part] = true;
       scene_.assemble(part);
-      plan_.steps.push_back({part, std::move(*trajectory), std::move(tried), allowed});
+      plan_.steps.push_back({part, std::move(*trajectory), std::move(tried), allowed, "", {}});
       if (extend()) return true;
       if (!sequence_.backtracks() || stopped_) return false;
       if (plan_.steps.size() > deepest_.size()) deepest_ = plan_.steps;  // the best partial plan, for the report
@@ -240,8 +242,20 @@ class Search {
 
 }  // namespace
 
+std::string step_name(const Product& product, const PlanStep& step) {
+  const std::string& part = product.parts()[step.part].name;
+  if (step.carried.empty()) return part;
+  std::vector<std::string> members{part};
+  for (PartIndex p : step.carried) members.push_back(product.parts()[p].name);
+  return step.subassembly + " (" + join(members) + ")";
+}
+
 Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
                    const PlannerOptions& options) {
+  if (!subassemblies_of(product.product).empty()) {
+    if (!options.given.empty()) throw std::logic_error("planning on from given steps of a product with subassemblies");
+    return plan_with_subassemblies(product, sequence, path, options);
+  }
   return Search(product, sequence, path, options).run();
 }
 

@@ -19,6 +19,18 @@ struct PlanStep {
   Trajectory trajectory;
   std::vector<Attempt> failed;  // collided tries before the one that worked
   std::vector<PartIndex> allowed;  // what the links allowed at this step (the part among them)
+  // A step of a subassembly's own plan (`carried` empty: built aside, its trajectory ends at
+  // the part's final pose moved by the subassembly's `aside`), or the step that inserts the
+  // whole subassembly: `part` is its base, whose trajectory this is, and `carried` the other
+  // members, which move with it at their places relative to the base.
+  std::string subassembly;
+  std::vector<PartIndex> carried;
+};
+
+struct SubassemblyPlan {
+  std::string name;
+  std::vector<PartIndex> members;  // the first is its base
+  Vec3 aside = Vec3::Zero();       // where it is built: its parts' final poses moved by this
 };
 
 struct Finding {
@@ -35,6 +47,7 @@ struct Plan {
   std::string path_planner;
   std::size_t backtracks = 0;
   std::size_t trajectories_simulated = 0;
+  std::vector<SubassemblyPlan> subassemblies;  // each one's steps come before the step inserting it
 };
 
 struct PlannerOptions {
@@ -48,6 +61,12 @@ struct PlannerOptions {
   fb::GripperGeometry gripper;
 };
 
+// What a step puts in: the part's name, or for a subassembly's insertion its name and its
+// parts' ("ShaftPendulum (shaft, pendulum)").
+std::string step_name(const Product& product, const PlanStep& step);
+
+// A product with subassemblies is planned in a hierarchy (subassembly_planner.hpp); `given`
+// steps are for a product without.
 Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
                    const PlannerOptions& options = {});
 

@@ -180,8 +180,11 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
   const int arm_material = gltf.material("arm", {0.9, 0.45, 0.05, 1});
   std::vector<std::pair<int, Track>> grippers;
 
-  // Time line: steps one after the other; a part is hidden (scale 0) until its step.
+  // Time line: steps one after the other; a part is hidden (scale 0) until its step. A
+  // subassembly's parts appear where it is built aside, and its insertion moves them all, each
+  // at its place relative to the base, from there to the trajectory's start in the gap.
   std::vector<Track> part_tracks(parts.size());
+  std::vector<Pose> at(parts.size(), Pose::Identity());  // where each part stands after its last key
   double t = 0;
   for (const auto& step : plan.steps) {
     const auto& w = step.trajectory.waypoints;
@@ -191,20 +194,29 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
                                                arm_material), w.front().gripper);
     Track& arm_track = grippers.emplace_back(node, Track{}).second;
     arm_track.key(0, w.front().gripper, 0);
-    Track& track = part_tracks[step.part];
-    track.key(0, w.front().part, 0);
-    if (t > 0) {
-      track.key(t, w.front().part, 0);
-      arm_track.key(t, w.front().gripper, 0);
+    if (t > 0) arm_track.key(t, w.front().gripper, 0);
+    std::vector<std::pair<PartIndex, Pose>> moving{{step.part, Pose::Identity()}};
+    for (PartIndex p : step.carried) moving.emplace_back(p, parts[step.part].final_pose.inverse() * parts[p].final_pose);
+    const auto key = [&](PartIndex p, double time, const Pose& pose, double scale) {
+      part_tracks[p].key(time, pose, scale);
+      at[p] = pose;
+    };
+    for (const auto& [p, relative] : moving) {
+      if (part_tracks[p].times.empty()) {
+        key(p, 0, w.front().part * relative, 0);
+        if (t > 0) key(p, t, w.front().part * relative, 0);
+      } else {
+        key(p, t, at[p], 1);
+      }
     }
     t += options.gap;
-    track.key(t, w.front().part, 1);
+    for (const auto& [p, relative] : moving) key(p, t, w.front().part * relative, 1);
     arm_track.key(t, w.front().gripper, 1);
     for (std::size_t i = 1; i < w.size(); ++i) {
       const double moved = std::max((w[i].part.translation() - w[i - 1].part.translation()).norm(),
                                     (w[i].gripper.translation() - w[i - 1].gripper.translation()).norm());
       t += std::max(options.min_segment, moved / options.speed);
-      track.key(t, w[i].part, 1);
+      for (const auto& [p, relative] : moving) key(p, t, w[i].part * relative, 1);
       arm_track.key(t, w[i].gripper, 1);
     }
     arm_track.key(t, w.back().gripper, 0);  // gone with its step

@@ -34,9 +34,13 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                         {"depth", a.collision->depth},
                         {"phase", a.collision->phase}});
     }
+    nlohmann::json carried = nlohmann::json::array();
+    for (PartIndex p : step.carried) carried.push_back(product.parts()[p].name);
     steps.push_back({{"step", i + 1},
                      {"part", part.name},
                      {"type", short_type_name(part.type)},
+                     {"subassembly", step.subassembly.empty() ? nlohmann::json() : nlohmann::json(step.subassembly)},
+                     {"carried", carried},
                      {"label", step.trajectory.label},
                      {"direction", vec(step.trajectory.direction)},
                      {"grasp", {{"label", step.trajectory.grasp.label},
@@ -47,6 +51,28 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                      {"tries", step.failed.size() + 1},
                      {"failed_tries", failed},
                      {"trajectory", trajectory}});
+  }
+  // The plan as a tree: the product's steps, where a subassembly's insertion holds the steps
+  // that build it (by step number).
+  nlohmann::json tree = nlohmann::json::array();
+  for (std::size_t i = 0; i < plan.steps.size(); ++i) {
+    const auto& step = plan.steps[i];
+    if (!step.subassembly.empty() && step.carried.empty()) continue;  // under its insertion
+    nlohmann::json node = {{"step", i + 1}, {"part", product.parts()[step.part].name}};
+    if (!step.carried.empty()) {
+      node["subassembly"] = step.subassembly;
+      nlohmann::json built = nlohmann::json::array();
+      for (std::size_t j = 0; j < plan.steps.size(); ++j) {
+        if (plan.steps[j].subassembly == step.subassembly && plan.steps[j].carried.empty()) {
+          built.push_back({{"step", j + 1}, {"part", product.parts()[plan.steps[j].part].name}});
+        }
+      }
+      node["built_by"] = built;
+      for (const auto& s : plan.subassemblies) {
+        if (s.name == step.subassembly) node["built_aside_at"] = vec(s.aside);
+      }
+    }
+    tree.push_back(node);
   }
   nlohmann::json findings = nlohmann::json::array();
   for (const auto& f : plan.findings) findings.push_back({{"kind", f.kind}, {"message", f.message}, {"parts", f.parts}});
@@ -60,6 +86,7 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
           {"backtracks", plan.backtracks},
           {"units", {{"length", "m"}}},
           {"steps", steps},
+          {"tree", tree},
           {"findings", findings}};
 }
 

@@ -79,8 +79,12 @@ class CaexReader {
       any_hierarchy = true;
       if (out_.product_name_.empty()) out_.product_name_ = product_name_of(hierarchy);
       collect_links(hierarchy);
+      int top_level = 0;
+      for_each_child(hierarchy, "InternalElement", [&](const pugi::xml_node&) { ++top_level; });
+      // The one element at the top is the product; beside others, a group is a subassembly.
+      const std::string none;
       for_each_child(hierarchy, "InternalElement",
-                     [&](const pugi::xml_node& e) { read_element(e); });
+                     [&](const pugi::xml_node& e) { read_element(e, top_level == 1 ? nullptr : &none); });
     });
     if (!any_hierarchy) {
       throw DescriptionError(file_.where(root), "the file has no InstanceHierarchy, so no parts");
@@ -167,29 +171,44 @@ class CaexReader {
     }
   }
 
-  void read_element(const pugi::xml_node& element) {
+  // `within`: null for the product's own element; else the subassembly the element lies in
+  // (empty: none yet, so a group here is one).
+  void read_element(const pugi::xml_node& element, const std::string* within) {
     const std::string raw_id = element.attribute("ID").value();
     if (raw_id.empty()) throw DescriptionError(file_.where(element), "InternalElement has no ID");
     const std::string id = normalize_id(raw_id);
     register_id(element, id);
     collect_links(element);
 
-    if (child(element, "InternalElement")) {  // a product or sub-assembly: its children are parts
+    if (child(element, "InternalElement")) {  // the product or a subassembly: its children are parts
       ++out_.group_count_;
       group_ids_.insert(id);
-      for_each_child(element, "InternalElement", [&](const pugi::xml_node& e) { read_element(e); });
+      const std::string* inner = within;
+      std::string name;
+      if (within == nullptr) {
+        inner = &name;  // the product's element: its groups are subassemblies
+      } else if (within->empty()) {
+        name = element.attribute("Name").value();
+        if (name.empty()) name = id;
+        if (!subassembly_names_.insert(name).second) {
+          throw DescriptionError(file_.where(element), "a second subassembly named '" + name + "'");
+        }
+        inner = &name;
+      }  // a group inside a subassembly belongs to it: one level of subassemblies
+      for_each_child(element, "InternalElement", [&](const pugi::xml_node& e) { read_element(e, inner); });
       return;
     }
-    read_part(element, id);
+    read_part(element, id, within ? *within : std::string());
   }
 
   void collect_links(const pugi::xml_node& element) {
     for_each_child(element, "InternalLink", [&](const pugi::xml_node& l) { links_.push_back(l); });
   }
 
-  void read_part(const pugi::xml_node& element, const std::string& id) {
+  void read_part(const pugi::xml_node& element, const std::string& id, const std::string& subassembly) {
     CreatePartItem part;
     part.id = id;
+    part.subassembly = subassembly;
     part.name = element.attribute("Name").value();
     part.where = file_.where(element);
     if (part.name.empty()) part.name = id;
@@ -386,6 +405,7 @@ class CaexReader {
   std::map<std::string, std::vector<pugi::xml_node>> type_chains_;
   std::unordered_map<std::string, pugi::xml_node> ids_;
   std::set<std::string> group_ids_;
+  std::set<std::string> subassembly_names_;
   std::unordered_map<std::string, std::pair<std::string, std::string>> interface_ids_;
   std::vector<pugi::xml_node> links_;
 };

@@ -1,0 +1,197 @@
+// Subassemblies: Cranfield with its shaft and pendulum as one (a nested InternalElement with
+// its own link), built aside first and then inserted as one rigid body.
+
+#include <algorithm>
+#include <fstream>
+
+#include <tiny_gltf.h>
+#include <unistd.h>
+
+#include "tests/twin/test_support.hpp"
+#include "twin/planning/subassembly_planner.hpp"
+#include "twin/report/gltf_animation.hpp"
+#include "twin/report/plan_json.hpp"
+
+namespace {
+
+const char* const kNested = "planning/cranfield-subassembly/cranfield-subassembly.aml";
+
+twin::Plan plan_of(const twin::LoadedProduct& loaded) {
+  twin::SearchSequencePlanner sequence;
+  return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"));
+}
+
+// A copy of the nested Cranfield with `from` replaced by `to` in its AML, beside its meshes.
+std::filesystem::path variant(const std::string& name, const std::string& from, const std::string& to) {
+  const auto source = test::data(kNested);
+  const auto dir = std::filesystem::temp_directory_path() / ("subassembly-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy(source.parent_path() / "meshes", dir / "meshes",
+                        std::filesystem::copy_options::recursive | std::filesystem::copy_options::overwrite_existing);
+  std::ifstream in(source);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, from.size(), to);
+  std::ofstream(dir / "product.aml") << text;
+  return dir / "product.aml";
+}
+
+}  // namespace
+
+TEST_CASE("subassemblies: a nested element's parts belong to it, and are placed as in the flat product",
+          "[planning][subassembly]") {
+  const auto nested = test::load(test::data(kNested));
+  const auto flat = test::load(test::product("cranfield/cranfield.aml"));
+  CHECK(test::part(nested.product, "shaft").subassembly == "ShaftPendulum");
+  CHECK(test::part(nested.product, "pendulum").subassembly == "ShaftPendulum");
+  CHECK(test::part(nested.product, "back").subassembly.empty());
+  const auto groups = twin::subassemblies_of(nested.product);
+  REQUIRE(groups.size() == 1);
+  CHECK(groups[0].name == "ShaftPendulum");
+  CHECK(groups[0].members.size() == 2);
+  for (const auto& part : flat.product.parts()) {
+    INFO(part.name);
+    CHECK(test::part(nested.product, part.name).final_pose.isApprox(part.final_pose, 1e-12));
+  }
+}
+
+TEST_CASE("subassemblies: built aside first, then inserted as one body", "[planning][subassembly]") {
+  const auto loaded = test::load(test::data(kNested));
+  const twin::Plan plan = plan_of(loaded);
+  REQUIRE(plan.complete);
+  const auto& parts = loaded.product.parts();
+  const twin::PartIndex shaft = *loaded.product.find_part_by_name("shaft");
+  const twin::PartIndex pendulum = *loaded.product.find_part_by_name("pendulum");
+  REQUIRE(plan.subassemblies.size() == 1);
+  const twin::Vec3 aside = plan.subassemblies[0].aside;
+  CHECK(aside.norm() > 0.05);
+  // One step per part, and one that inserts the subassembly.
+  REQUIRE(plan.steps.size() == parts.size() + 1);
+  const auto insertion = std::find_if(plan.steps.begin(), plan.steps.end(), [](const auto& s) { return !s.carried.empty(); });
+  REQUIRE(insertion != plan.steps.end());
+  CHECK(insertion->part == shaft);
+  CHECK(insertion->carried == std::vector<twin::PartIndex>{pendulum});
+  CHECK(twin::step_name(loaded.product, *insertion) == "ShaftPendulum (shaft, pendulum)");
+  CHECK(insertion->trajectory.waypoints.back().part.isApprox(parts[shaft].final_pose, 1e-9));
+  // Its own steps come before it, built aside: each ends at its final pose moved aside.
+  std::size_t built = 0;
+  for (auto it = plan.steps.begin(); it != insertion; ++it) {
+    if (it->subassembly != "ShaftPendulum") continue;
+    ++built;
+    twin::Pose expected = parts[it->part].final_pose;
+    expected.pretranslate(aside);
+    CHECK(it->trajectory.waypoints.back().part.isApprox(expected, 1e-9));
+  }
+  CHECK(built == 2);
+  for (auto it = insertion + 1; it != plan.steps.end(); ++it) CHECK(it->subassembly.empty());
+
+  // plan.json: the tree holds the insertion with the steps that build it.
+  const auto json = twin::plan_json(loaded.product, plan);
+  const auto& tree = json.at("tree");
+  CHECK(tree.size() == parts.size() - 1);
+  const auto node = std::find_if(tree.begin(), tree.end(), [](const auto& n) { return n.contains("subassembly"); });
+  REQUIRE(node != tree.end());
+  CHECK(node->at("built_by").size() == 2);
+  CHECK(node->at("built_by")[0].at("part") == "shaft");
+}
+
+TEST_CASE("subassemblies: the animation builds it aside and carries the pendulum in with the shaft", "[planning][subassembly][gltf]") {
+  const auto loaded = test::load(test::data(kNested));
+  const twin::Plan plan = plan_of(loaded);
+  REQUIRE(plan.complete);
+  const auto file = std::filesystem::temp_directory_path() / ("subassembly-" + std::to_string(::getpid()) + ".gltf");
+  twin::write_gltf_animation(loaded, plan, file);
+  tinygltf::Model model;
+  tinygltf::TinyGLTF reader;
+  std::string error, warning;
+  REQUIRE(reader.LoadASCIIFromFile(&model, &error, &warning, file.string()));
+  std::filesystem::remove(file);
+  const auto node = std::find_if(model.nodes.begin(), model.nodes.end(), [](const auto& n) { return n.name == "pendulum"; });
+  REQUIRE(node != model.nodes.end());
+  const int pendulum = static_cast<int>(node - model.nodes.begin());
+  const twin::Vec3 final_place = test::part(loaded.product, "pendulum").final_pose.translation();
+  const twin::Vec3 aside_place = final_place + plan.subassemblies[0].aside;
+  bool was_aside = false, ends_in_place = false;
+  for (const auto& channel : model.animations.at(0).channels) {
+    if (channel.target_node != pendulum || channel.target_path != "translation") continue;
+    const auto& output = model.accessors[model.animations[0].samplers[channel.sampler].output];
+    const auto& view = model.bufferViews[output.bufferView];
+    const auto* values = reinterpret_cast<const float*>(model.buffers[view.buffer].data.data() + view.byteOffset);
+    for (std::size_t k = 0; k < output.count; ++k) {
+      const twin::Vec3 at(values[3 * k], values[3 * k + 1], values[3 * k + 2]);
+      was_aside = was_aside || (at - aside_place).norm() < 1e-5;
+    }
+    const float* last = values + 3 * (output.count - 1);
+    ends_in_place = (twin::Vec3(last[0], last[1], last[2]) - final_place).norm() < 1e-5;
+  }
+  CHECK(was_aside);
+  CHECK(ends_in_place);
+}
+
+TEST_CASE("subassemblies: one that cannot be built on its own makes the plan incomplete and says where",
+          "[planning][subassembly]") {
+  // The back and front plates as one subassembly: nothing links them to each other.
+  const auto file = variant("plates", "<InternalElement Name=\"ShaftPendulum\"", "<InternalElement Name=\"Plates\"");
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  // Move the two plates into the group, the shaft and pendulum out of it.
+  const auto cut = [&](const std::string& start) {
+    const auto from = text.find(start);
+    REQUIRE(from != std::string::npos);
+    const auto to = text.find("</InternalElement>", from) + std::string("</InternalElement>").size();
+    std::string element = text.substr(from, to - from);
+    text.erase(from, to - from);
+    return element;
+  };
+  const std::string back_element = cut("<InternalElement Name=\"back\"");
+  const std::string front_element = cut("<InternalElement Name=\"front\"");
+  const std::string shaft_element = cut("<InternalElement Name=\"shaft\"");
+  const std::string pendulum_element = cut("<InternalElement Name=\"pendulum\"");
+  const auto group = text.find("<InternalElement Name=\"Plates\"");
+  const auto inside = text.find('>', group) + 1;
+  text.insert(inside, back_element + front_element);
+  text.insert(group, shaft_element + pendulum_element);
+  std::ofstream(file) << text;
+  const auto loaded = test::load(file);
+  std::filesystem::remove_all(file.parent_path());
+  REQUIRE(test::part(loaded.product, "back").subassembly == "Plates");
+  REQUIRE(test::part(loaded.product, "front").subassembly == "Plates");
+  const twin::Plan plan = plan_of(loaded);
+  CHECK_FALSE(plan.complete);
+  const auto said = std::find_if(plan.findings.begin(), plan.findings.end(), [](const auto& f) {
+    return f.message.rfind("subassembly Plates: ", 0) == 0 && f.message.find("front") != std::string::npos;
+  });
+  INFO(plan.findings.size() << " findings");
+  CHECK(said != plan.findings.end());
+}
+
+TEST_CASE("subassemblies: a group inside one belongs to it, and two of one name are an error", "[planning][subassembly]") {
+  const auto inner = variant("inner", "<InternalElement Name=\"pendulum\"",
+                             "<InternalElement Name=\"Swing\" ID=\"inner-group\"><InternalElement Name=\"pendulum\"");
+  {
+    std::ifstream in(inner);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    const auto pendulum = text.find("<InternalElement Name=\"pendulum\"");
+    const auto end = text.find("</InternalElement>", pendulum) + std::string("</InternalElement>").size();
+    text.insert(end, "</InternalElement>");
+    std::ofstream(inner) << text;
+  }
+  const auto loaded = test::load(inner);
+  CHECK(test::part(loaded.product, "pendulum").subassembly == "ShaftPendulum");
+  std::filesystem::remove_all(inner.parent_path());
+
+  const auto twice = variant("twice", "<InternalElement Name=\"boltA1\"",
+                             "<InternalElement Name=\"ShaftPendulum\" ID=\"second\"><InternalElement Name=\"x\" ID=\"x1\"/>"
+                             "<InternalElement Name=\"y\" ID=\"y1\"/></InternalElement><InternalElement Name=\"boltA1\"");
+  try {
+    test::load(twice);
+    FAIL("no error");
+  } catch (const twin::DescriptionError& e) {
+    CHECK(std::string(e.what()).find("product.aml:") != std::string::npos);
+    CHECK(std::string(e.what()).find("a second subassembly named 'ShaftPendulum'") != std::string::npos);
+  }
+  std::filesystem::remove_all(twice.parent_path());
+}

@@ -1,0 +1,224 @@
+#include "twin/planning/subassembly_planner.hpp"
+
+#include <cctype>
+#include <map>
+
+namespace twin {
+namespace {
+
+constexpr double kAsideGap = 0.05;  // m between the product and a subassembly built beside it
+
+Eigen::AlignedBox3d final_bounds(const LoadedProduct& product, const std::vector<PartIndex>& parts) {
+  Eigen::AlignedBox3d box;
+  for (PartIndex p : parts) {
+    const Pose& pose = product.product.parts()[p].final_pose;
+    if (const auto& mesh = product.meshes[p]) {
+      for (const auto& v : mesh->vertices) box.extend(pose * v);
+    } else {
+      box.extend(pose.translation());
+    }
+  }
+  return box;
+}
+
+Product empty_like(const Product& product, const std::string& name) {
+  Product out(name, product.source());
+  for (const auto& [type, part_type] : product.types()) {
+    for (const auto& [interface, frame] : part_type.interfaces) out.set_type_interface(type, interface, frame);
+  }
+  return out;
+}
+
+DigitalPart alone(DigitalPart part) {
+  part.subassembly.clear();
+  return part;
+}
+
+// The subassembly as a product of its own, built beside the product on the station.
+LoadedProduct subassembly_product(const LoadedProduct& product, const Subassembly& s, const Vec3& aside) {
+  LoadedProduct out{empty_like(product.product, product.product.name() + "/" + s.name), {}};
+  std::map<PartIndex, PartIndex> index;
+  for (PartIndex m : s.members) {
+    DigitalPart part = alone(product.product.parts()[m]);
+    part.final_pose.pretranslate(aside);
+    index[m] = out.product.add_part(std::move(part));
+    out.meshes.push_back(product.meshes[m]);
+  }
+  for (const Connection& c : product.product.connections()) {
+    if (!index.count(c.part1) || !index.count(c.part2)) continue;
+    const auto& parts = product.product.parts();
+    out.product.connect(parts[c.part1].id, c.interface1, parts[c.part2].id, c.interface2, c.name, c.where);
+  }
+  return out;
+}
+
+// The product with each subassembly one part (named after it, at its base's pose, of its
+// members' merged mesh), linked to the rest where its members are. `origin`: what each part
+// of the result stands for, in the product.
+LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<Subassembly>& subassemblies,
+                               std::vector<const Subassembly*>& unit_of, std::vector<PartIndex>& origin) {
+  const auto& parts = product.product.parts();
+  LoadedProduct out{empty_like(product.product, product.product.name()), {}};
+  std::map<PartIndex, const Subassembly*> member_of;
+  for (const auto& s : subassemblies) {
+    for (PartIndex m : s.members) member_of[m] = &s;
+  }
+  std::map<const Subassembly*, std::string> unit_id;
+  for (PartIndex p = 0; p < parts.size(); ++p) {
+    const auto it = member_of.find(p);
+    if (it == member_of.end()) {
+      out.product.add_part(alone(parts[p]));
+      out.meshes.push_back(product.meshes[p]);
+      unit_of.push_back(nullptr);
+      origin.push_back(p);
+      continue;
+    }
+    const Subassembly& s = *it->second;
+    if (p != s.members.front()) continue;
+    DigitalPart unit;
+    unit.id = "subassembly " + parts[p].id;
+    unit.name = s.name;
+    unit.final_pose = parts[p].final_pose;
+    unit.where = parts[p].where;
+    // Its members' interfaces that link it to the rest, as "member/interface".
+    for (const Connection& c : product.product.connections()) {
+      for (const auto& [end, interface] : {std::pair{c.part1, c.interface1}, std::pair{c.part2, c.interface2}}) {
+        if (member_of.count(end) && member_of[end] == &s) {
+          unit.own_interfaces[parts[end].name + "/" + interface] = *product.product.interface_of(end, interface);
+        }
+      }
+    }
+    unit_id[&s] = unit.id;
+    out.product.add_part(std::move(unit));
+    out.meshes.push_back(merged_mesh(product, s.members));
+    unit_of.push_back(&s);
+    origin.push_back(p);
+  }
+  const auto end_of = [&](PartIndex p, const std::string& interface) -> std::pair<std::string, std::string> {
+    const auto it = member_of.find(p);
+    if (it == member_of.end()) return {parts[p].id, interface};
+    return {unit_id.at(it->second), parts[p].name + "/" + interface};
+  };
+  for (const Connection& c : product.product.connections()) {
+    if (member_of.count(c.part1) && member_of.count(c.part2) && member_of[c.part1] == member_of[c.part2]) continue;
+    const auto [a, ia] = end_of(c.part1, c.interface1);
+    const auto [b, ib] = end_of(c.part2, c.interface2);
+    out.product.connect(a, ia, b, ib, c.name, c.where);
+  }
+  return out;
+}
+
+std::vector<PartIndex> mapped(const std::vector<PartIndex>& parts, const std::vector<PartIndex>& to) {
+  std::vector<PartIndex> out;
+  for (PartIndex p : parts) out.push_back(to[p]);
+  return out;
+}
+
+// A finding that names a step ("step 3: ...") names it by its number in the whole plan.
+std::string renumbered(const std::string& message, std::size_t offset) {
+  std::size_t digits = 0;
+  if (message.rfind("step ", 0) != 0 || offset == 0) return message;
+  while (5 + digits < message.size() && std::isdigit(static_cast<unsigned char>(message[5 + digits]))) ++digits;
+  if (digits == 0) return message;
+  return "step " + std::to_string(std::stoul(message.substr(5, digits)) + offset) + message.substr(5 + digits);
+}
+
+// `from`'s steps are in `into` already, the last ones.
+void add_plan(Plan& into, Plan from, const std::string& prefix) {
+  into.complete = into.complete && from.complete;
+  into.backtracks += from.backtracks;
+  into.trajectories_simulated += from.trajectories_simulated;
+  for (auto& f : from.findings) {
+    f.message = prefix + renumbered(f.message, into.steps.size() - from.steps.size());
+    into.findings.push_back(std::move(f));
+  }
+}
+
+}  // namespace
+
+std::vector<Subassembly> subassemblies_of(const Product& product) {
+  std::vector<Subassembly> out;
+  std::map<std::string, std::size_t> by_name;
+  for (PartIndex p = 0; p < product.parts().size(); ++p) {
+    const std::string& name = product.parts()[p].subassembly;
+    if (name.empty()) continue;
+    const auto [it, fresh] = by_name.emplace(name, out.size());
+    if (fresh) out.push_back({name, {}});
+    out[it->second].members.push_back(p);
+  }
+  return out;
+}
+
+std::shared_ptr<const sim::TriangleMesh> merged_mesh(const LoadedProduct& product, const std::vector<PartIndex>& members) {
+  auto out = std::make_shared<sim::TriangleMesh>();
+  const Pose base = product.product.parts()[members.front()].final_pose.inverse();
+  for (PartIndex m : members) {
+    const auto& mesh = product.meshes[m];
+    if (!mesh) continue;
+    const Pose to_base = base * product.product.parts()[m].final_pose;
+    const auto first = static_cast<std::uint32_t>(out->vertices.size());
+    for (const auto& v : mesh->vertices) {
+      out->vertices.push_back(to_base * v);
+      out->bounds.extend(out->vertices.back());
+    }
+    for (const auto& t : mesh->triangles) out->triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
+    if (mesh->pieces.size() > 1 || mesh->convex) {
+      for (const auto& piece : mesh->pieces) {
+        out->pieces.emplace_back();
+        for (auto v : piece) out->pieces.back().push_back(v + first);
+      }
+    } else {
+      for (const auto& t : mesh->triangles) out->pieces.push_back({t[0] + first, t[1] + first, t[2] + first});
+    }
+  }
+  if (out->pieces.size() == 1) out->convex = sim::is_convex(*out);
+  out->hull_corners = sim::hull_corners(*out);
+  return out;
+}
+
+Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
+                             const PlannerOptions& options) {
+  const std::vector<Subassembly> subassemblies = subassemblies_of(product.product);
+  Plan plan;
+  plan.complete = true;
+  plan.sequence_planner = sequence.name();
+  plan.path_planner = path.name();
+
+  // Each subassembly built beside what stands left of it, its lowest point on the station.
+  std::vector<PartIndex> all(product.product.parts().size());
+  for (PartIndex p = 0; p < all.size(); ++p) all[p] = p;
+  double beside = final_bounds(product, all).max().x() + kAsideGap;
+  for (const Subassembly& s : subassemblies) {
+    const Eigen::AlignedBox3d box = final_bounds(product, s.members);
+    const Vec3 aside(beside - box.min().x(), -box.min().y(), 0);
+    beside += box.sizes().x() + kAsideGap;
+    Plan own = plan_assembly(subassembly_product(product, s, aside), sequence, path, options);
+    for (PlanStep step : own.steps) {
+      step.part = s.members[step.part];
+      step.allowed = mapped(step.allowed, s.members);
+      step.subassembly = s.name;
+      plan.steps.push_back(std::move(step));
+    }
+    add_plan(plan, std::move(own), "subassembly " + s.name + ": ");
+    plan.subassemblies.push_back({s.name, s.members, aside});
+  }
+
+  std::vector<const Subassembly*> unit_of;
+  std::vector<PartIndex> origin;
+  const LoadedProduct units = product_of_units(product, subassemblies, unit_of, origin);
+  Plan top = plan_assembly(units, sequence, path, options);
+  for (PlanStep step : top.steps) {
+    const Subassembly* unit = unit_of[step.part];
+    step.allowed = mapped(step.allowed, origin);
+    if (unit) {
+      step.subassembly = unit->name;
+      step.carried.assign(unit->members.begin() + 1, unit->members.end());
+    }
+    step.part = origin[step.part];
+    plan.steps.push_back(std::move(step));
+  }
+  add_plan(plan, std::move(top), "");
+  return plan;
+}
+
+}  // namespace twin

@@ -1,0 +1,31 @@
+#pragma once
+// Products with subassemblies (docs/automationml.md, "Subassemblies"): each subassembly is
+// planned on its own, as a product of its parts and the links between them, built aside on
+// the station; then the product is planned with each subassembly as one rigid body, whose
+// links are those of its parts to the rest. The plan lists a subassembly's steps before the
+// step that inserts it, in the product's part indices.
+
+#include <string>
+#include <vector>
+
+#include "twin/planning/assembly_planner.hpp"
+
+namespace twin {
+
+struct Subassembly {
+  std::string name;
+  std::vector<PartIndex> members;  // in the product's order; the first is its base
+};
+
+// In the order their first parts come in the product.
+std::vector<Subassembly> subassemblies_of(const Product& product);
+
+// One body of several parts' meshes, in the frame of `members.front()`: each member's convex
+// pieces stay pieces, and a concave one-piece member's triangles each become one, so that
+// its bores stay open.
+std::shared_ptr<const sim::TriangleMesh> merged_mesh(const LoadedProduct& product, const std::vector<PartIndex>& members);
+
+Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
+                             const PlannerOptions& options);
+
+}  // namespace twin
