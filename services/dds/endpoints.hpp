@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <malloc.h>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -142,7 +143,14 @@ class Outbox {
 
  private:
   void flush_locked() {
+    if (kept_.empty()) return;
     while (!kept_.empty() && writer_.write(kept_.front())) kept_.pop_front();
+    if (kept_.empty()) {
+      // A backlog of bounded samples (a command event is 2.3 kB) is megabytes: given back to
+      // the system once it is out, so that a flood leaves no trace in resident memory.
+      std::deque<T>().swap(kept_);
+      ::malloc_trim(0);
+    }
   }
 
   Writer<T, PubSubType> writer_;
