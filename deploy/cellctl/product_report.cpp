@@ -4,6 +4,7 @@
 #include <map>
 
 #include "deploy/cellctl/text_table.hpp"
+#include "twin/planning/subassembly_planner.hpp"
 
 namespace cellctl {
 
@@ -42,6 +43,7 @@ nlohmann::json product_json(const twin::LoadedProduct& loaded, const twin::Inter
                         {"orientation", {q.w(), q.x(), q.y(), q.z()}}};
     if (part.color) j["color"] = *part.color;
     if (part.mesh) j["mesh"] = part.mesh->file.filename().string();
+    if (!part.subassembly.empty()) j["subassembly"] = part.subassembly;
     parts.push_back(std::move(j));
   }
   nlohmann::json connections = nlohmann::json::array();
@@ -91,6 +93,11 @@ void print_product_table(const twin::LoadedProduct& loaded, const twin::Interfer
                    fixed(r.z(), 1), part.mesh ? part.mesh->file.filename().string() : "-"});
   }
   parts.print(out);
+  for (const auto& s : twin::subassemblies_of(product)) {
+    out << "subassembly " << s.name << ":";
+    for (twin::PartIndex p : s.members) out << ' ' << product.parts()[p].name;
+    out << " (built first, then inserted as one)\n";
+  }
   out << '\n';
   TextTable links({"link", "part", "interface", "part", "interface"});
   for (const auto& c : product.connections()) {

@@ -84,7 +84,6 @@ struct DeepestContact : btCollisionWorld::ContactResultCallback {
   }
 };
 
-
 }  // namespace
 
 // --- MovingBody ---------------------------------------------------------------------------

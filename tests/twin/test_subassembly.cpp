@@ -195,3 +195,21 @@ TEST_CASE("subassemblies: a group inside one belongs to it, and two of one name 
   }
   std::filesystem::remove_all(twice.parent_path());
 }
+
+TEST_CASE("subassemblies: an order element holding the product's element is not one", "[planning][subassembly]") {
+  const auto file = variant("order", "<InternalElement Name=\"CranfieldBenchmark\"",
+                            "<InternalElement Name=\"Order\" ID=\"order-1\"><InternalElement Name=\"CranfieldBenchmark\"");
+  {
+    std::ifstream in(file);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    text.insert(text.find("</InstanceHierarchy>"), "</InternalElement>");
+    std::ofstream(file) << text;
+  }
+  const auto loaded = test::load(file);
+  std::filesystem::remove_all(file.parent_path());
+  const auto groups = twin::subassemblies_of(loaded.product);
+  REQUIRE(groups.size() == 1);
+  CHECK(groups[0].name == "ShaftPendulum");
+  CHECK(test::part(loaded.product, "back").subassembly.empty());
+}

@@ -186,7 +186,12 @@ class CaexReader {
       const std::string* inner = within;
       std::string name;
       if (within == nullptr) {
-        inner = &name;  // the product's element: its groups are subassemblies
+        // The product's element: its groups are subassemblies; but a lone group in it is the
+        // product's element again (an order holding a product holding the parts).
+        int children = 0;
+        for_each_child(element, "InternalElement", [&](const pugi::xml_node&) { ++children; });
+        const bool lone_group = children == 1 && child(child(element, "InternalElement"), "InternalElement");
+        inner = lone_group ? nullptr : &name;
       } else if (within->empty()) {
         name = element.attribute("Name").value();
         if (name.empty()) name = id;
