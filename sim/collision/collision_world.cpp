@@ -27,10 +27,8 @@ btTransform to_bullet(const Pose& pose) {
                      to_bullet(Eigen::Vector3d(pose.translation())));
 }
 
-// The hull of a mesh's piece, of the corners loading found (mesh.hull_corners): a bore's or
-// a stud's inner vertices would only slow every support query of GJK.
-std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t piece, double margin) {
-  const auto& points = piece < mesh.hull_corners.size() ? mesh.hull_corners[piece] : mesh.pieces[piece];
+std::unique_ptr<btConvexHullShape> hull_through(const TriangleMesh& mesh, const std::vector<std::uint32_t>& points,
+                                                double margin) {
   auto hull = std::make_unique<btConvexHullShape>();
   for (auto index : points) hull->addPoint(to_bullet(mesh.vertices[index]), false);
   hull->recalcLocalAabb();
@@ -38,15 +36,17 @@ std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t
   return hull;
 }
 
+// The hull of a mesh's piece, of the corners loading found (mesh.hull_corners): a bore's or
+// a stud's inner vertices would only slow every support query of GJK.
+std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t piece, double margin) {
+  return hull_through(mesh, piece < mesh.hull_corners.size() ? mesh.hull_corners[piece] : mesh.pieces[piece], margin);
+}
+
 // The coarse hull of a concave one-piece mesh (triangle_mesh.hpp): a few hull corners grown
 // to hold the rest, or the hull itself.
 std::unique_ptr<btConvexHullShape> coarse_hull_of(const TriangleMesh& mesh, double margin) {
   if (mesh.coarse_corners.empty()) return hull_of(mesh, 0, margin);
-  auto hull = std::make_unique<btConvexHullShape>();
-  for (auto index : mesh.coarse_corners) hull->addPoint(to_bullet(mesh.vertices[index]), false);
-  hull->recalcLocalAabb();
-  hull->setMargin((margin + mesh.coarse_margin) * kUnitsPerMetre);
-  return hull;
+  return hull_through(mesh, mesh.coarse_corners, margin + mesh.coarse_margin);
 }
 
 constexpr int kCoarse = 1;  // user index 2 of a static body's hull that stands before its BVH

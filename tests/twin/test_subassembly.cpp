@@ -16,6 +16,11 @@ namespace {
 
 const char* const kNested = "planning/cranfield-subassembly/cranfield-subassembly.aml";
 
+std::string text_of(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 twin::Plan plan_of(const twin::LoadedProduct& loaded) {
   twin::SearchSequencePlanner sequence;
   return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"));
@@ -28,8 +33,7 @@ std::filesystem::path variant(const std::string& name, const std::string& from, 
   std::filesystem::create_directories(dir);
   std::filesystem::copy(source.parent_path() / "meshes", dir / "meshes",
                         std::filesystem::copy_options::recursive | std::filesystem::copy_options::overwrite_existing);
-  std::ifstream in(source);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text = text_of(source);
   const auto at = text.find(from);
   REQUIRE(at != std::string::npos);
   text.replace(at, from.size(), to);
@@ -133,9 +137,7 @@ TEST_CASE("subassemblies: one that cannot be built on its own makes the plan inc
           "[planning][subassembly]") {
   // The back and front plates as one subassembly: nothing links them to each other.
   const auto file = variant("plates", "<InternalElement Name=\"ShaftPendulum\"", "<InternalElement Name=\"Plates\"");
-  std::ifstream in(file);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  in.close();
+  std::string text = text_of(file);
   // Move the two plates into the group, the shaft and pendulum out of it.
   const auto cut = [&](const std::string& start) {
     const auto from = text.find(start);
@@ -171,9 +173,7 @@ TEST_CASE("subassemblies: a group inside one belongs to it, and two of one name 
   const auto inner = variant("inner", "<InternalElement Name=\"pendulum\"",
                              "<InternalElement Name=\"Swing\" ID=\"inner-group\"><InternalElement Name=\"pendulum\"");
   {
-    std::ifstream in(inner);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    in.close();
+    std::string text = text_of(inner);
     const auto pendulum = text.find("<InternalElement Name=\"pendulum\"");
     const auto end = text.find("</InternalElement>", pendulum) + std::string("</InternalElement>").size();
     text.insert(end, "</InternalElement>");
@@ -200,9 +200,7 @@ TEST_CASE("subassemblies: an order element holding the product's element is not 
   const auto file = variant("order", "<InternalElement Name=\"CranfieldBenchmark\"",
                             "<InternalElement Name=\"Order\" ID=\"order-1\"><InternalElement Name=\"CranfieldBenchmark\"");
   {
-    std::ifstream in(file);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    in.close();
+    std::string text = text_of(file);
     text.insert(text.find("</InstanceHierarchy>"), "</InternalElement>");
     std::ofstream(file) << text;
   }
