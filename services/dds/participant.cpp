@@ -2,12 +2,18 @@
 
 #include <iostream>
 #include <stdexcept>
+#include <vector>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
+
+#include "cell_idl/simulationPubSubTypes.h"
 
 namespace dds {
 
@@ -32,6 +38,40 @@ class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
  private:
   std::string name_;
 };
+
+// Fast DDS 2.9.1 walks the participant's list of local readers (WLP::readers_, a std::vector)
+// without a lock whenever a matched writer's liveliness changes (its first sample, a lease
+// that ran out), while creating a reader appends to that list from the creating thread. An
+// append that grows the vector frees the storage under the walk: a mobile robot died so at
+// start-up under TSan (SEGV in WLP::sub_liveliness_changed), and its cell never came up.
+// Creating and deleting kReaderSlots readers before any reader of ours exists grows the list
+// once, while no liveliness change can come (no reader is matched yet); later appends stay in
+// place. A station, the largest, creates 16 readers (two resources of 8 each); creating and
+// deleting 32 costs about 14 ms of a process's start (docs/performance.md).
+constexpr int kReaderSlots = 32;
+
+void reserve_reader_slots(eprosima::fastdds::dds::DomainParticipant& participant) {
+  using namespace eprosima::fastdds::dds;
+  TypeSupport type(new cell::ClockPubSubType());
+  if (type.register_type(&participant) != ReturnCode_t::RETCODE_OK) return;
+  Topic* topic = participant.create_topic("cell/reader_slots", type.get_type_name(), TOPIC_QOS_DEFAULT);
+  Subscriber* subscriber = participant.create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (topic && subscriber) {
+    DataReaderQos qos = DATAREADER_QOS_DEFAULT;
+    qos.history().depth = 1;
+    qos.resource_limits().max_samples = 1;
+    qos.resource_limits().max_instances = 1;
+    qos.resource_limits().max_samples_per_instance = 1;
+    std::vector<DataReader*> readers;
+    for (int i = 0; i < kReaderSlots; ++i) {
+      if (DataReader* r = subscriber->create_datareader(topic, qos)) readers.push_back(r);
+    }
+    for (DataReader* r : readers) subscriber->delete_datareader(r);
+  }
+  if (subscriber) participant.delete_subscriber(subscriber);
+  if (topic) participant.delete_topic(topic);
+  participant.unregister_type(type.get_type_name());
+}
 
 }  // namespace
 
@@ -73,6 +113,7 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
     throw std::runtime_error("cannot create DDS participant '" + name + "' on domain " +
                              std::to_string(settings.domain_id));
   }
+  reserve_reader_slots(*participant);
   return ParticipantPtr(participant, [log](DomainParticipant* p) {
     p->set_listener(nullptr);
     p->delete_contained_entities();
