@@ -9,7 +9,7 @@ packages=(
   libassimp-dev libtinygltf-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libyaml-cpp-dev
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
   libbenchmark-dev libsqlite3-dev sqlite3 libcgal-dev
-  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
 )
 
 missing=()

@@ -37,6 +37,7 @@ struct CellOptions {
   double real_time_factor = 0;
   double wait_s = 30;
   std::string state_dir;
+  std::string security_dir;
 
   CellConfig load() const;
 };
@@ -46,6 +47,8 @@ void add_cell_options(CLI::App* cmd, CellOptions& o) {
   cmd->add_option("--domain", o.domain, "DDS domain id, instead of the file's")->check(CLI::Range(0, 232));
   cmd->add_option("--real-time-factor", o.real_time_factor, "Instead of the file's")->check(CLI::PositiveNumber);
   cmd->add_option("--state-dir", o.state_dir, "Folder of the cell's database, instead of the file's state_dir");
+  cmd->add_option("--security", o.security_dir, "DDS-Security: the folder `cellctl pki init` wrote, instead of the file's")
+      ->check(CLI::ExistingDirectory);
 }
 
 fs::path pid_file(int domain) {
@@ -94,6 +97,7 @@ CellConfig CellOptions::load() const {
   CellConfig c = read_cell_config(cell);
   if (domain >= 0) c.domain = domain;
   if (real_time_factor > 0) c.real_time_factor = real_time_factor;
+  if (!security_dir.empty()) c.security_dir = fs::absolute(security_dir);
   if (!state_dir.empty()) {
     c.state_dir = state_dir;
   } else if (const std::string running = running_state_dir(c.domain); !running.empty()) {
@@ -330,7 +334,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
                                "` stops it");
     }
     if (stale) std::cerr << "cellctl up: the last cellctl up on this domain was killed; starting the cell afresh\n";
-    CellObserver observer(cell.domain, cell.localhost_only);
+    CellObserver observer(cell.participant_settings("cellctl"));
     state::CellStore store(cell.state_folder());
     store.journal("cellctl", "up", "", "domain " + std::to_string(cell.domain));
     bool world_lost = false;  // cell-sim restarts: the twins' virtual scenes went with it
@@ -384,7 +388,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
     CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
-    CellObserver observer(cell.domain, cell.localhost_only);
+    CellObserver observer(cell.participant_settings("cellctl"));
     auto orders = orders_of(*submit_options);
     // Read once: an up that started after load() looked (its pid file is new) keeps its
     // state where it says, and that is where its desk reads orders.
@@ -414,7 +418,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   status->add_flag("--json", *json, "As one JSON object (docs/cli.md gives its shape)");
   status->callback([cell_options, json] {
     const CellConfig cell = cell_options->load();
-    CellObserver observer(cell.domain, cell.localhost_only);
+    CellObserver observer(cell.participant_settings("cellctl"));
     observer.wait_for_resources(cell.resource_ids(), 2s);
     std::this_thread::sleep_for(300ms);  // orders and resources outside the file
     const nlohmann::json report = cell_status(cell, observer);
@@ -486,7 +490,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
-    CellObserver observer(cell.domain, cell.localhost_only);
+    CellObserver observer(cell.participant_settings("cellctl"));
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));

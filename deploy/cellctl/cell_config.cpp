@@ -170,7 +170,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper"});
+              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -198,6 +198,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, root, "state_dir", dir);
     if (dir.empty()) throw ConfigError(where(file, root["state_dir"]) + ": state_dir names a folder");
     c.state_dir = file.parent_path() / dir;
+  }
+  if (root["security"]) {
+    std::string dir;
+    read(file, root, "security", dir);
+    if (dir.empty()) throw ConfigError(where(file, root["security"]) + ": security names the folder `cellctl pki init` wrote");
+    c.security_dir = std::filesystem::absolute(file.parent_path() / dir);
   }
   if (const YAML::Node gripper = root["gripper"]) {
     std::set<std::string> names;
@@ -248,6 +254,22 @@ std::filesystem::path CellConfig::state_folder() const {
   return base / "agile-cell" / ("domain-" + std::to_string(domain));
 }
 
+dds::ParticipantSettings CellConfig::participant_settings(const std::string& identity) const {
+  dds::ParticipantSettings s;
+  s.domain_id = domain;
+  s.localhost_only = localhost_only;
+  if (!security_dir.empty()) s.security = {security_dir, identity};
+  return s;
+}
+
+namespace {
+
+void add_security(std::vector<std::string>& argv, const CellConfig& c) {
+  if (!c.security_dir.empty()) argv.insert(argv.end(), {"--security", c.security_dir.string()});
+}
+
+}  // namespace
+
 std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::path& bin, const std::string& order,
                                    const std::string& product, const std::string& out, const std::string& sequence,
                                    const std::string& path, const std::filesystem::path& state_dir, double wait_s) {
@@ -256,6 +278,7 @@ std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::p
                                 std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--quiet"};
   if (!state_dir.empty()) argv.insert(argv.end(), {"--state-dir", state_dir.string()});
   if (!c.localhost_only) argv.push_back("--all-interfaces");
+  add_security(argv, c);
   add_gripper(argv, c.gripper);
   return argv;
 }
@@ -302,6 +325,7 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
   for (auto& p : out) {
     p.argv.insert(p.argv.end(), {"--state-dir", c.state_folder().string()});
     if (!c.localhost_only) p.argv.push_back("--all-interfaces");
+    add_security(p.argv, c);
   }
   return out;
 }

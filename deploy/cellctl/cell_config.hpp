@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "services/dds/participant.hpp"
 #include "services/node/gripper.hpp"
 
 namespace cellctl {
@@ -62,8 +63,13 @@ struct CellConfig {
   // `state_dir:` the folder of the cell's database (relative to the file's folder); empty:
   // $XDG_STATE_HOME (or ~/.local/state)/agile-cell/domain-N.
   std::filesystem::path state_dir;
+  // `security:` the folder `cellctl pki init` wrote (relative to the file's folder); every
+  // process of the cell, its twins and cellctl then use DDS-Security. Empty: off.
+  std::filesystem::path security_dir;
 
   std::vector<std::string> resource_ids() const;
+  // How a participant of this cell with `identity` (docs/security.md) joins its domain.
+  dds::ParticipantSettings participant_settings(const std::string& identity) const;
   std::filesystem::path state_folder() const;
 };
 

@@ -23,8 +23,8 @@ struct CellObserver::Impl {
   std::unique_ptr<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>> events;
 };
 
-CellObserver::CellObserver(int domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
-  impl_->participant = dds::make_participant("cellctl", {domain, localhost_only});
+CellObserver::CellObserver(const dds::ParticipantSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->participant = dds::make_participant("cellctl", settings);
   impl_->clock = std::make_unique<dds::SimClock>(impl_->participant);
   const auto changed = [this](auto&& f) {
     {

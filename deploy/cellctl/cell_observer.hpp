@@ -15,6 +15,7 @@
 
 #include "capabilities.h"
 #include "orders.h"
+#include "services/dds/participant.hpp"
 
 namespace cellctl {
 
@@ -25,7 +26,7 @@ struct ResourceView {
 
 class CellObserver {
  public:
-  CellObserver(int domain, bool localhost_only);
+  explicit CellObserver(const dds::ParticipantSettings& settings);
   ~CellObserver();
 
   // Writes every command event (and every delivery) as one JSON line to `file` from now on.

@@ -8,6 +8,7 @@
 #include "deploy/cellctl/cell_commands.hpp"
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/describe_command.hpp"
+#include "deploy/cellctl/pki_command.hpp"
 #include "deploy/cellctl/plan_command.hpp"
 #include "twin/model/source_ref.hpp"
 
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
   cellctl::add_describe_command(app, exit_code);
   cellctl::add_plan_command(app, exit_code);
   cellctl::add_cell_commands(app, exit_code);
+  cellctl::add_pki_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

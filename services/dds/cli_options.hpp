@@ -1,6 +1,7 @@
 #pragma once
-// The DDS options every cell process takes: --domain N (required) and --all-interfaces
-// (the deployment file's `localhost_only: false`; without it, loopback only).
+// The DDS options every cell process takes: --domain N (required), --all-interfaces (the
+// deployment file's `localhost_only: false`; without it, loopback only), and --security DIR
+// with --identity NAME (the deployment file's `security: DIR`; docs/security.md).
 
 #include <CLI/CLI.hpp>
 
@@ -14,6 +15,9 @@ namespace dds {
 inline void add_dds_options(CLI::App& app, ParticipantSettings& settings, bool& all_interfaces) {
   app.add_option("--domain", settings.domain_id, "DDS domain id")->required()->check(CLI::Range(0, 232));
   app.add_flag("--all-interfaces", all_interfaces, "Use every network interface, not only loopback");
+  app.add_option("--security", settings.security.dir, "DDS-Security: the folder `cellctl pki init` wrote (default: off)");
+  app.add_option("--identity", settings.security.identity,
+                 "DDS-Security: the identity under DIR/identities (default: the process's name)");
 }
 
 // --cell-bounds XMIN YMIN ZMIN XMAX YMAX ZMAX: the box every commanded position lies in.

@@ -37,6 +37,15 @@ namespace fdds = eprosima::fastdds::dds;
 // in its reader) another resource's commands.
 inline std::string command_topic(const std::string& resource_id) { return "cell/commands/" + resource_id; }
 
+// Why Fast DDS refused an endpoint, as far as we know: under DDS-Security, the identity's
+// permissions (Fast DDS logs which rule), else nothing more to say.
+inline std::string refusal_reason(const fdds::DomainParticipant& participant) {
+  for (const auto& p : participant.get_qos().properties().properties()) {
+    if (p.name() == "dds.sec.access.plugin") return ": this identity's DDS-Security permissions do not allow it";
+  }
+  return "";
+}
+
 // The topic of that name on the participant, created (and its type registered) if needed.
 template <class PubSubType>
 fdds::Topic* topic_on(fdds::DomainParticipant& participant, const std::string& name) {
@@ -44,7 +53,7 @@ fdds::Topic* topic_on(fdds::DomainParticipant& participant, const std::string& n
   type.register_type(&participant);
   if (auto* existing = participant.find_topic(name, eprosima::fastrtps::Duration_t(0, 0))) return existing;
   fdds::Topic* topic = participant.create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
-  if (!topic) throw std::runtime_error("cannot create topic " + name);
+  if (!topic) throw std::runtime_error("cannot create topic " + name + refusal_reason(participant));
   return topic;
 }
 
@@ -55,7 +64,7 @@ class Writer : private fdds::DataWriterListener {
       : participant_(std::move(participant)) {
     publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     writer_ = publisher_->create_datawriter(topic_on<PubSubType>(*participant_, topic), writer_qos(kind, settings), this);
-    if (!writer_) throw std::runtime_error("cannot create a writer on " + topic);
+    if (!writer_) throw std::runtime_error("cannot create a writer on " + topic + refusal_reason(*participant_));
   }
   // A matched callback already under way finishes first; later ones find the writer closed.
   ~Writer() override {
@@ -170,7 +179,7 @@ class Reader : private fdds::DataReaderListener {
       : participant_(std::move(participant)), kind_(kind), on_sample_(std::move(on_sample)), on_gone_(std::move(on_gone)) {
     subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
-    if (!reader_) throw std::runtime_error("cannot create a reader on " + topic);
+    if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
   }
   // A drain already under way finishes first; later callbacks find the reader closed.
   ~Reader() override {

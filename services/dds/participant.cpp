@@ -34,6 +34,15 @@ class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
                 << " dropped: its discovery lease ran out\n";
     }
   }
+  // Fast DDS logs why (a certificate of another CA, an expired one, permissions that do not
+  // match); this line says that it refused, and whom.
+  void onParticipantAuthentication(eprosima::fastdds::dds::DomainParticipant*,
+                                   eprosima::fastrtps::rtps::ParticipantAuthenticationInfo&& info) override {
+    if (info.status == eprosima::fastrtps::rtps::ParticipantAuthenticationInfo::UNAUTHORIZED_PARTICIPANT) {
+      std::cerr << name_ << ": refused DDS participant " << info.guid
+                << ": it failed authentication (no certificate, or one the cell's CA did not sign or that expired)\n";
+    }
+  }
 
  private:
   std::string name_;
@@ -106,6 +115,12 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   // dies is noticed by the 5 s liveliness of its capability, not by this lease.
   qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
   qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(20.0);
+  if (!settings.security.dir.empty()) {
+    const std::string identity = settings.security.identity.empty() ? name : settings.security.identity;
+    const IdentityFiles files = identity_files(settings.security.dir, identity);
+    check_identity(files, identity);
+    apply_security(qos, files);
+  }
   DomainParticipantFactory* factory = DomainParticipantFactory::get_instance();
   auto log = std::make_shared<DiscoveryLog>(name);
   DomainParticipant* participant = factory->create_participant(settings.domain_id, qos, log.get(), StatusMask::none());

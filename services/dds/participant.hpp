@@ -9,17 +9,21 @@
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
+#include "services/dds/security.hpp"
+
 namespace dds {
 
 struct ParticipantSettings {
   int domain_id = 0;
   bool localhost_only = true;
+  SecuritySettings security;  // off unless security.dir is set (services/dds/security.hpp)
 };
 
 // Deletes the participant and everything it created when the last owner lets go.
 using ParticipantPtr = std::shared_ptr<eprosima::fastdds::dds::DomainParticipant>;
 
-// Throws std::runtime_error when Fast DDS refuses to create it.
+// Throws SecurityError when its identity's files are wrong, std::runtime_error when Fast DDS
+// refuses to create it.
 ParticipantPtr make_participant(const std::string& name, const ParticipantSettings& settings);
 
 }  // namespace dds

@@ -70,7 +70,7 @@ void report(const std::string& what, const std::vector<double>& us) {
 
 int echo(int domain) {
   std::signal(SIGTERM, stop);
-  auto participant = dds::make_participant("bench-echo", {domain, true});
+  auto participant = dds::make_participant("bench-echo", {domain, true, {}});
   EventWriter pong(participant, "bench/pong", dds::TopicKind::events);
   CommandReader ping(participant, "bench/ping", dds::TopicKind::events, [&](const cell::Command& c) {
     cell::CommandEvent e;
@@ -115,7 +115,7 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
 void twin_start(int domain, int rounds) {
   test::ChildProcess sim({CELL_SIM_EXE, "--domain", std::to_string(domain)}, "/dev/null");
   test::ChildProcess station({STATION_EXE, "--domain", std::to_string(domain)}, "/dev/null");
-  auto participant = dds::make_participant("bench-observer", {domain, true});
+  auto participant = dds::make_participant("bench-observer", {domain, true, {}});
   std::mutex mutex;
   std::condition_variable changed;
   // The latest status per order (keep last 1: statuses in quick succession may coalesce).
@@ -181,7 +181,7 @@ void under_load(const char* self, int domain, int rounds) {
   args.insert(args.end(), {"--out", "/tmp/bench-cell-load"});
   test::ChildProcess cell(args, "/tmp/bench-cell-load.log");
   std::this_thread::sleep_for(3s);  // the cell is up and the twins plan and assemble virtually
-  auto participant = dds::make_participant("bench", {domain, true});
+  auto participant = dds::make_participant("bench", {domain, true, {}});
   {
     test::ChildProcess echo_side({self, "--echo", std::to_string(domain)});
     report("while 10 orders run: bare Fast DDS ping-pong", round_trips(participant, "bench/ping", "bench/pong", "echo", rounds));
@@ -209,7 +209,7 @@ int main(int argc, char** argv) {
   test::clean_stale_dds_segments();
   const int domain = 199;
   try {
-    auto participant = dds::make_participant("bench", {domain, true});
+    auto participant = dds::make_participant("bench", {domain, true, {}});
     {
       test::ChildProcess echo_side({argv[0], "--echo", std::to_string(domain)});
       report("bare Fast DDS ping-pong, two processes", round_trips(participant, "bench/ping", "bench/pong", "echo", rounds));

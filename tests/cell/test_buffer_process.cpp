@@ -81,7 +81,7 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-1", "--domain", std::to_string(kDomain), "--stock",
                              "SquarePeg=1", "--lease", "0.5"});
   Seen seen;
-  auto participant = dds::make_participant("test-twin", {kDomain, true});
+  auto participant = dds::make_participant("test-twin", {kDomain, true, {}});
   const auto capabilities = watch_capabilities(participant, seen);
   dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
       participant, "cell/command_events", dds::TopicKind::events,
@@ -141,7 +141,7 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-2", "--domain", std::to_string(domain), "--stock",
                              "RoundPeg=3", "--lease", "0.5"});
   Seen seen;
-  auto participant = dds::make_participant("test-twin", {domain, true});
+  auto participant = dds::make_participant("test-twin", {domain, true, {}});
   const auto capabilities = watch_capabilities(participant, seen);
   REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
   CHECK(stock_of(seen.capabilities.back(), "RoundPeg") == 3);

@@ -67,7 +67,7 @@ class HostileCell {
       : domain_(std::to_string(domain)), dir_(test::scratch(name)),
         up_({CELLCTL_EXE, "up", "--domain", domain_, "--real-time-factor", "20", "--state-dir", (dir_ / "state").string()},
             (dir_ / "up.log").string()),
-        intruder_(dds::make_participant("intruder", {domain, true})) {
+        intruder_(dds::make_participant("intruder", {domain, true, {}})) {
     events_ = std::make_unique<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>>(
         intruder_, "cell/command_events", dds::TopicKind::events, [this](const cell::CommandEvent& e) {
           add([&] { events_of_[e.command_id().to_string()].push_back(e); });

@@ -385,6 +385,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(o.dds, all_interfaces);
+  if (o.dds.security.identity.empty()) o.dds.security.identity = "twin";  // every twin has the role's identity
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   services::stop_with_parent();

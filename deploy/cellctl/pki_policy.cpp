@@ -1,0 +1,138 @@
+#include "deploy/cellctl/pki_policy.hpp"
+
+#include <sstream>
+
+namespace cellctl::pki {
+
+namespace {
+
+using Topics = std::vector<std::string>;
+
+std::string commands(const std::string& id) { return "cell/commands/" + id; }
+
+Topics operator+(Topics a, const Topics& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Every process makes 32 readers on this topic at start (services/dds/participant.cpp).
+const Topics kEveryone = {"cell/reader_slots"};
+
+// What every resource does (services/node/resource_node.cpp): its capability and command
+// events, bids and award replies; it reads calls, awards, releases, cancels, the orders'
+// status and the clock.
+Grant resource(const std::string& id, const std::string& role, const Topics& own_command_topics, bool moves) {
+  Grant g{id, role,
+          {"cell/capabilities", "cell/command_events", "cell/negotiation/proposals", "cell/negotiation/replies"},
+          own_command_topics + Topics{"cell/cancel_requests", "cell/negotiation/calls", "cell/negotiation/awards",
+                                      "cell/negotiation/releases", "cell/orders/status", "cell/clock"} + kEveryone};
+  if (moves) {  // it asks cell-sim to move its bodies
+    g.publish.push_back("cell/sim/requests");
+    g.subscribe.push_back("cell/sim/replies");
+  }
+  return g;
+}
+
+void topics_xml(std::ostream& out, const char* tag, const Topics& topics) {
+  if (topics.empty()) return;
+  out << "        <" << tag << ">\n          <topics>\n";
+  for (const auto& t : topics) out << "            <topic>" << t << "</topic>\n";
+  out << "          </topics>\n        </" << tag << ">\n";
+}
+
+}  // namespace
+
+std::vector<Grant> cell_grants(const CellConfig& cell) {
+  std::vector<Grant> grants;
+  grants.push_back({"cell-sim", "cell-sim", {"cell/sim/replies", "cell/clock", "cell/capabilities"},
+                    Topics{"cell/sim/requests", "cell/negotiation/replies", "cell/orders/status"} + kEveryone});
+  Topics commanded;  // what a twin commands: the arms and the robots
+  for (const auto& s : cell.stations) {
+    grants.push_back(resource(s.id, "station", {commands(s.id), commands(s.arm)}, true));
+    commanded.push_back(commands(s.arm));
+  }
+  Topics buffers;
+  for (const auto& b : cell.buffers) {
+    grants.push_back(resource(b.id, "buffer", {commands(b.id)}, false));
+    buffers.push_back(commands(b.id));
+  }
+  for (const auto& r : cell.robots) {
+    Grant g = resource(r.id, "mobile-robot", {commands(r.id)}, true);
+    g.publish = g.publish + buffers;  // the robot has buffers give it parts
+    g.subscribe = g.subscribe + Topics{"cell/capabilities", "cell/command_events"};
+    grants.push_back(g);
+    commanded.push_back(commands(r.id));
+  }
+  grants.push_back({"twin", "twin",
+                    Topics{"cell/orders/status", "cell/orders/result", "cell/negotiation/calls", "cell/negotiation/awards",
+                           "cell/negotiation/releases", "cell/cancel_requests", "cell/sim/requests"} + commanded,
+                    Topics{"cell/clock", "cell/capabilities", "cell/negotiation/proposals", "cell/negotiation/replies",
+                           "cell/command_events", "cell/sim/replies"} + kEveryone});
+  grants.push_back({"cellctl", "cellctl", {},
+                    Topics{"cell/clock", "cell/capabilities", "cell/orders/status", "cell/orders/result",
+                           "cell/command_events"} + kEveryone});
+  return grants;
+}
+
+std::string governance_xml(int domain) {
+  std::ostringstream out;
+  out << R"(<?xml version="1.0" encoding="UTF-8"?>
+<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
+     xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
+  <domain_access_rules>
+    <domain_rule>
+      <domains>
+        <id>)" << domain << R"(</id>
+      </domains>
+      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
+      <enable_join_access_control>true</enable_join_access_control>
+      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
+      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>
+      <rtps_protection_kind>NONE</rtps_protection_kind>
+      <topic_access_rules>
+        <topic_rule>
+          <topic_expression>*</topic_expression>
+          <enable_discovery_protection>true</enable_discovery_protection>
+          <enable_liveliness_protection>true</enable_liveliness_protection>
+          <enable_read_access_control>true</enable_read_access_control>
+          <enable_write_access_control>true</enable_write_access_control>
+          <metadata_protection_kind>ENCRYPT</metadata_protection_kind>
+          <data_protection_kind>ENCRYPT</data_protection_kind>
+        </topic_rule>
+      </topic_access_rules>
+    </domain_rule>
+  </domain_access_rules>
+</dds>
+)";
+  return out.str();
+}
+
+std::string permissions_xml(const Grant& grant, int domain, const Validity& validity) {
+  std::ostringstream out;
+  out << R"(<?xml version="1.0" encoding="UTF-8"?>
+<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
+     xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">
+  <permissions>
+    <grant name=")" << grant.identity << R"(">
+      <subject_name>CN=)" << grant.identity << R"(</subject_name>
+      <validity>
+        <not_before>)" << xml_time(validity.not_before) << R"(</not_before>
+        <not_after>)" << xml_time(validity.not_before + std::chrono::hours(24) * validity.days) << R"(</not_after>
+      </validity>
+      <allow_rule>
+        <domains>
+          <id>)" << domain << R"(</id>
+        </domains>
+)";
+  topics_xml(out, "publish", grant.publish);
+  topics_xml(out, "subscribe", grant.subscribe);
+  out << R"(      </allow_rule>
+      <default>DENY</default>
+    </grant>
+  </permissions>
+</dds>
+)";
+  return out.str();
+}
+
+}  // namespace cellctl::pki

@@ -1,0 +1,30 @@
+#pragma once
+// What each identity of a cell may publish and read (docs/security.md): the DDS-Security
+// governance of the cell's domain and one permissions grant per identity, from the cell's
+// deployment file. Topic names as in docs/topics.md.
+
+#include <string>
+#include <vector>
+
+#include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/pki.hpp"
+
+namespace cellctl::pki {
+
+struct Grant {
+  std::string identity;  // the certificate's CN and its folder under DIR/identities
+  std::string role;      // cell-sim, station, mobile-robot, buffer, twin, cellctl
+  std::vector<std::string> publish, subscribe;
+};
+
+// One per process of the cell (cell-sim, each station, robot and buffer), one for every twin
+// ("twin") and one for cellctl, the operator's observer.
+std::vector<Grant> cell_grants(const CellConfig& cell);
+
+// Authenticated participants only; discovery, liveliness and every topic's data encrypted;
+// read and write access control on every topic.
+std::string governance_xml(int domain);
+
+std::string permissions_xml(const Grant& grant, int domain, const Validity& validity);
+
+}  // namespace cellctl::pki

@@ -1,0 +1,208 @@
+// DDS-Security on a cell (docs/security.md): `cellctl pki init` makes the files, a cell that
+// uses them assembles orders, and participants without the cell's certificates, or with the
+// wrong ones, get nothing and do nothing. Every process is ended by its id; every wait is
+// bounded; loopback only, on domains of their own.
+
+#include <sys/stat.h>
+
+#include <atomic>
+#include <filesystem>
+#include <mutex>
+#include <set>
+
+#include <catch2/catch.hpp>
+
+#include "capabilitiesPubSubTypes.h"
+#include "commandsPubSubTypes.h"
+#include "services/dds/endpoints.hpp"
+#include "tests/support/cell_test.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const std::string kLego = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+const std::vector<std::string> kResources{"station-1", "arm-1", "mobile-robot-1", "buffer-1", "buffer-2"};
+
+unsigned mode_of(const fs::path& p) {
+  struct stat st {};
+  REQUIRE(::stat(p.c_str(), &st) == 0);
+  return st.st_mode & 0777;
+}
+
+// The resources whose capability a participant sees.
+class Sightings {
+ public:
+  Sightings(const dds::ParticipantPtr& participant)
+      : reader_(participant, "cell/capabilities", dds::TopicKind::state, [this](const cell::Capability& c) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          seen_.insert(c.resource_id().to_string());
+          for (const auto& s : c.stock()) part_types_.insert(s.part_type().to_string());
+        }) {}
+  std::set<std::string> seen() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return seen_;
+  }
+  bool saw_part_type(const std::string& type) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return part_types_.count(type) > 0;
+  }
+  bool wait_for(const std::vector<std::string>& ids, std::chrono::seconds timeout) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      const auto s = seen();
+      if (std::all_of(ids.begin(), ids.end(), [&](const std::string& id) { return s.count(id) > 0; })) return true;
+      std::this_thread::sleep_for(50ms);
+    }
+    return false;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::set<std::string> seen_, part_types_;
+  dds::Reader<cell::Capability, cell::CapabilityPubSubType> reader_;
+};
+
+// A buffer process with `args` after its domain; its exit code within 20 s (-1: still running).
+int buffer_exit(const std::string& domain, std::vector<std::string> args, const fs::path& log) {
+  args.insert(args.begin(), {BUFFER_EXE, "--domain", domain});
+  test::ChildProcess p(args, log.string());
+  return p.wait_for_exit(20s);
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner reads, a certificate and permissions by role",
+          "[process][security]") {
+  const fs::path dir = test::scratch("pki-init");
+  const fs::path pki = dir / "pki";
+  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--domain", "224"}, dir / "init.log") == 0);
+  INFO(test::read_text(dir / "init.log"));
+  CHECK(mode_of(pki) == 0700);
+  CHECK(mode_of(pki / "ca.key.pem") == 0600);
+  CHECK(fs::exists(pki / "ca.cert.pem"));
+  CHECK(test::read_text(pki / "governance.p7s").find("application/x-pkcs7-signature") != std::string::npos);
+  for (const std::string id : {"cell-sim", "station-1", "mobile-robot-1", "buffer-1", "buffer-2", "twin", "cellctl"}) {
+    INFO(id);
+    const fs::path own = pki / "identities" / id;
+    CHECK(mode_of(own) == 0700);
+    CHECK(mode_of(own / "key.pem") == 0600);
+    CHECK(fs::exists(own / "cert.pem"));
+    CHECK(test::read_text(own / "permissions.p7s").find("<subject_name>CN=" + id + "</subject_name>") != std::string::npos);
+  }
+  // By role: a buffer reads its own commands only and commands nobody; a twin commands the arm
+  // and the robot but publishes no capability; cellctl only reads.
+  const auto permissions = [&](const std::string& id) { return test::read_text(pki / "identities" / id / "permissions.xml"); };
+  const auto section = [](const std::string& xml, const std::string& tag) {
+    const auto from = xml.find("<" + tag + ">"), to = xml.find("</" + tag + ">");
+    return from == std::string::npos ? std::string() : xml.substr(from, to - from);
+  };
+  CHECK(section(permissions("buffer-1"), "subscribe").find("cell/commands/buffer-1") != std::string::npos);
+  CHECK(permissions("buffer-1").find("cell/commands/buffer-2") == std::string::npos);
+  CHECK(section(permissions("buffer-1"), "publish").find("cell/commands/") == std::string::npos);
+  CHECK(section(permissions("twin"), "publish").find("cell/commands/arm-1") != std::string::npos);
+  CHECK(section(permissions("twin"), "publish").find("cell/capabilities") == std::string::npos);
+  CHECK(section(permissions("cellctl"), "publish").empty());
+  CHECK(section(permissions("mobile-robot-1"), "publish").find("cell/commands/buffer-1") != std::string::npos);
+
+  // A cell keeps its CA: a second init refuses and changes nothing.
+  const std::string ca_key = test::read_text(pki / "ca.key.pem");
+  CHECK(test::cellctl({"pki", "init", pki.string(), "--domain", "224"}, dir / "again.log") == 1);
+  CHECK(test::read_text(dir / "again.log").find("ca.key.pem exists") != std::string::npos);
+  CHECK(test::read_text(pki / "ca.key.pem") == ca_key);
+  // An identity the cell does not have is not issued.
+  CHECK(test::cellctl({"pki", "issue", pki.string(), "buffer-9", "--domain", "224"}, dir / "issue.log") == 2);
+  CHECK(test::read_text(dir / "issue.log").find("buffer-9 is no identity of the cell") != std::string::npos);
+}
+
+TEST_CASE("secure cell: orders are assembled, and without a certificate, with a foreign or expired one, or on a topic of another role nothing is done",
+          "[process][security][cell]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("secure-cell");
+  const std::string domain = "225";
+  const fs::path pki = dir / "pki", foreign = dir / "foreign", stale = dir / "stale";
+  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--domain", domain}, dir / "init.log") == 0);
+  REQUIRE(test::cellctl({"pki", "init", foreign.string(), "--domain", domain}, dir / "foreign.log") == 0);
+  fs::copy(pki, stale, fs::copy_options::recursive);
+  REQUIRE(test::cellctl({"pki", "issue", stale.string(), "buffer-2", "--domain", domain, "--days", "1", "--backdate-days", "2"},
+                        dir / "stale.log") == 0);
+
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--security", pki.string(), "--real-time-factor", "50",
+                         "--state-dir", (dir / "state").string()},
+                        (dir / "up.log").string());
+  const auto up_log = [&] { return test::read_text(dir / "up.log"); };
+
+  auto trusted = dds::make_participant("test-operator", {std::stoi(domain), true, {pki, "cellctl"}});
+  Sightings trusted_sees(trusted);
+  {
+    INFO(up_log());
+    REQUIRE(trusted_sees.wait_for(kResources, 60s));
+  }
+
+  {  // A participant without a certificate discovers nothing, and its commands reach nobody.
+    auto intruder = dds::make_participant("intruder", {std::stoi(domain), true, {}});
+    Sightings intruder_sees(intruder);
+    dds::Writer<cell::Command, cell::CommandPubSubType> to_arm(intruder, dds::command_topic("arm-1"), dds::TopicKind::events,
+                                                                dds::command_qos());
+    CHECK_FALSE(to_arm.wait_for_readers(1, 5s));
+    CHECK(intruder_sees.seen().empty());
+    CHECK(test::appears(dir / "up.log", "refused DDS participant", 10s));
+  }
+
+  {  // A twin's certificate cannot publish a capability, nor a buffer's read another's commands.
+    const int as_twin = buffer_exit(domain, {"--id", "buffer-7", "--security", pki.string(), "--identity", "twin"}, dir / "twin.log");
+    const std::string twin_log = test::read_text(dir / "twin.log");
+    INFO(twin_log);
+    CHECK(as_twin != 0);
+    CHECK(twin_log.find("cannot create a writer on cell/capabilities: this identity's DDS-Security permissions do not allow it") !=
+          std::string::npos);
+    const int other = buffer_exit(domain, {"--id", "buffer-1", "--security", pki.string(), "--identity", "buffer-2"}, dir / "other.log");
+    const std::string other_log = test::read_text(dir / "other.log");
+    INFO(other_log);
+    CHECK(other != 0);
+    CHECK(other_log.find("cannot create a reader on cell/commands/buffer-1") != std::string::npos);
+    CHECK(trusted_sees.seen().count("buffer-7") == 0);
+  }
+
+  {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.
+    const int expired = buffer_exit(domain, {"--id", "buffer-2", "--security", stale.string()}, dir / "expired.log");
+    const std::string expired_log = test::read_text(dir / "expired.log");
+    INFO(expired_log);
+    CHECK(expired != 0);
+    CHECK(expired_log.find("identity 'buffer-2'") != std::string::npos);
+    CHECK(expired_log.find("the certificate expired on") != std::string::npos);
+
+    // A buffer-1 with a certificate of another cell's CA (its own check passes: its CA signed
+    // it), and stock the cell's buffer-1 does not have.
+    const std::size_t refusals_before = count_of(up_log(), "refused DDS participant");
+    test::ChildProcess stranger({BUFFER_EXE, "--domain", domain, "--id", "buffer-1", "--security", foreign.string(),
+                                 "--stock", "Stolen=5"},
+                                (dir / "stranger.log").string());
+    CHECK(test::appears(dir / "stranger.log", "ready on domain", 20s));
+    CHECK(test::appears(dir / "stranger.log", "refused DDS participant", 20s));
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (count_of(up_log(), "refused DDS participant") == refusals_before && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(100ms);
+    }
+    CHECK(count_of(up_log(), "refused DDS participant") > refusals_before);
+    std::this_thread::sleep_for(2s);
+    CHECK_FALSE(trusted_sees.saw_part_type("Stolen"));
+    CHECK(stranger.stop() == 0);
+  }
+
+  // Whatever was tried, the cell assembles an order of a trusted submitter.
+  const int order = test::cellctl({"submit", kLego, "--domain", domain, "--security", pki.string(), "--order", "after",
+                                   "--out", (dir / "after").string()},
+                                  dir / "after.log");
+  INFO(test::read_text(dir / "after.log") << up_log());
+  CHECK(order == 0);
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
