@@ -18,6 +18,8 @@
 #include "deploy/cellctl/cell_status.hpp"
 #include "deploy/cellctl/order_desk.hpp"
 #include "deploy/cellctl/processes.hpp"
+#include "deploy/cellctl/remote_desk.hpp"
+#include "deploy/cellctl/remote_submit.hpp"
 #include "deploy/cellctl/supervisor.hpp"
 #include "deploy/cellctl/text_table.hpp"
 #include "services/state/cell_store.hpp"
@@ -172,6 +174,8 @@ void print_progress(const cell::OrderStatus& s) {
 struct SubmitOptions {
   std::vector<std::string> products;
   std::string order, out, sequence = "search", path = "linear";
+  bool remote = false;
+  std::string client;
 };
 
 void add_submit_options(CLI::App* cmd, SubmitOptions& o, bool several) {
@@ -334,7 +338,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
                                "` stops it");
     }
     if (stale) std::cerr << "cellctl up: the last cellctl up on this domain was killed; starting the cell afresh\n";
-    CellObserver observer(cell.participant_settings("cellctl"));
+    CellObserver observer(cell.participant_settings("order-desk"));
     state::CellStore store(cell.state_folder());
     store.journal("cellctl", "up", "", "domain " + std::to_string(cell.domain));
     bool world_lost = false;  // cell-sim restarts: the twins' virtual scenes went with it
@@ -362,10 +366,13 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
               << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"
               << std::endl;
-    OrderDesk desk(cell, store, [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; });
+    const auto log = [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; };
+    OrderDesk desk(cell, store, log);
+    RemoteDesk remote(cell, store, observer, log);
     while (!stop_requested) {
       if (world_lost) desk.interrupt_all();
       world_lost = false;
+      remote.tend();
       desk.tend();
       if (const std::string why = supervisor.tend(); !why.empty()) {
         std::cerr << "error: " << why << "; stopping the cell. Look at that process's output above, fix the cause, "
@@ -385,9 +392,22 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   CLI::App* submit_cmd = app.add_subcommand("submit", "Hand an order to the cell of cellctl up on the domain (or, with none, run its twin here) and follow it to its end");
   add_cell_options(submit_cmd, *cell_options);
   add_submit_options(submit_cmd, *submit_options, false);
+  submit_cmd->add_flag("--remote", submit_options->remote,
+                       "Send the order to the cell's order desk over DDS, as --client (docs/order-desk.md)");
+  submit_cmd->add_option("--client", submit_options->client, "The client's id (the cell's `clients:`; with --security its identity)");
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
     CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
+    if (submit_options->remote) {
+      if (submit_options->client.empty()) throw CLI::ValidationError("--client", "--remote needs the client's id");
+      const auto orders = orders_of(*submit_options);
+      const Order& order = orders.front();
+      RemoteSubmission s{order.product, submit_options->client, order.id, order.out, submit_options->sequence,
+                         cell.participant_settings(submit_options->client),
+                         std::chrono::seconds(static_cast<long>(cell_options->wait_s))};
+      exit_code = submit_remote(s, stop_requested);
+      return;
+    }
     CellObserver observer(cell.participant_settings("cellctl"));
     auto orders = orders_of(*submit_options);
     // Read once: an up that started after load() looked (its pid file is new) keeps its

@@ -170,7 +170,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security"});
+              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -198,6 +198,21 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, root, "state_dir", dir);
     if (dir.empty()) throw ConfigError(where(file, root["state_dir"]) + ": state_dir names a folder");
     c.state_dir = file.parent_path() / dir;
+  }
+  read(file, root, "clients", c.clients);
+  for (const auto& id : c.clients) {
+    if (id.empty() || id.size() > 64 || id.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos) {
+      throw ConfigError(where(file, root["clients"]) + ": a client id is 1 to 64 of a-z, 0-9, - and _ ('" + id + "' is not)");
+    }
+  }
+  if (const YAML::Node desk = root["desk"]) {
+    known_keys(file, desk, {"max_order_mb", "orders_per_minute", "max_orders"});
+    read(file, desk, "max_order_mb", c.desk.max_order_mb);
+    read(file, desk, "orders_per_minute", c.desk.orders_per_minute);
+    read(file, desk, "max_orders", c.desk.max_orders);
+    if (!(c.desk.max_order_mb > 0) || c.desk.orders_per_minute < 1 || c.desk.max_orders < 1) {
+      throw ConfigError(where(file, desk) + ": max_order_mb must be above 0, orders_per_minute and max_orders 1 or more");
+    }
   }
   if (root["security"]) {
     std::string dir;

@@ -44,6 +44,14 @@ struct RestartPolicy {
   std::chrono::milliseconds max_backoff{8000};
 };
 
+// `desk: {max_order_mb: 64, orders_per_minute: 6, max_orders: 4}`: what the order desk takes
+// from remote clients (docs/order-desk.md); past a limit it refuses with the reason.
+struct DeskLimits {
+  double max_order_mb = 64;   // the product's files, all together
+  int orders_per_minute = 6;  // per client
+  int max_orders = 4;         // orders under way in the cell (twins), from any client
+};
+
 struct CellConfig {
   std::filesystem::path file;
   int domain = 42;
@@ -66,6 +74,9 @@ struct CellConfig {
   // `security:` the folder `cellctl pki init` wrote (relative to the file's folder); every
   // process of the cell, its twins and cellctl then use DDS-Security. Empty: off.
   std::filesystem::path security_dir;
+  // `clients: [oem-a, oem-b]`: who may submit over DDS (the order desk's topics per client).
+  std::vector<std::string> clients;
+  DeskLimits desk;
 
   std::vector<std::string> resource_ids() const;
   // How a participant of this cell with `identity` (docs/security.md) joins its domain.

@@ -82,6 +82,8 @@ void CellObserver::log_events_to(const std::string& file) {
   if (!events_) throw std::runtime_error("cannot write " + file);
 }
 
+const dds::ParticipantPtr& CellObserver::participant() const { return impl_->participant; }
+
 void CellObserver::on_status(std::function<void(const cell::OrderStatus&)> callback) {
   std::lock_guard<std::mutex> lock(mutex_);
   on_status_ = std::move(callback);

@@ -29,6 +29,9 @@ class CellObserver {
   explicit CellObserver(const dds::ParticipantSettings& settings);
   ~CellObserver();
 
+  // Its participant, for other endpoints of the same process (the remote order desk).
+  const dds::ParticipantPtr& participant() const;
+
   // Writes every command event (and every delivery) as one JSON line to `file` from now on.
   void log_events_to(const std::string& file);
   // Called with each new order status (on a DDS thread).

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "deploy/cellctl/file_transfer.hpp"
+
 namespace cellctl::pki {
 
 namespace {
@@ -68,9 +70,19 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
                            "cell/negotiation/releases", "cell/cancel_requests", "cell/sim/requests"} + commanded,
                     Topics{"cell/clock", "cell/capabilities", "cell/negotiation/proposals", "cell/negotiation/replies",
                            "cell/command_events", "cell/sim/replies"} + kEveryone});
-  grants.push_back({"cellctl", "cellctl", {},
-                    Topics{"cell/clock", "cell/capabilities", "cell/orders/status", "cell/orders/result",
-                           "cell/command_events"} + kEveryone});
+  const Topics observer = Topics{"cell/clock", "cell/capabilities", "cell/orders/status", "cell/orders/result",
+                                 "cell/command_events"} + kEveryone;
+  grants.push_back({"cellctl", "cellctl", {}, observer});
+  // cellctl up: it observes the cell and runs the order desk of every client.
+  Grant desk{"order-desk", "order-desk", {}, observer};
+  for (const auto& c : cell.clients) {
+    desk.publish = desk.publish + Topics{desk_topic("replies", c), desk_topic("results", c)};
+    desk.subscribe = desk.subscribe + Topics{desk_topic("files", c), desk_topic("orders", c)};
+    // A client sends its orders and reads its own answers: nothing of the cell, nor of others.
+    grants.push_back({c, "client", {desk_topic("files", c), desk_topic("orders", c)},
+                      Topics{desk_topic("replies", c), desk_topic("results", c)} + kEveryone});
+  }
+  grants.push_back(desk);
   return grants;
 }
 

@@ -13,12 +13,13 @@ namespace cellctl::pki {
 
 struct Grant {
   std::string identity;  // the certificate's CN and its folder under DIR/identities
-  std::string role;      // cell-sim, station, mobile-robot, buffer, twin, cellctl
+  std::string role;      // cell-sim, station, mobile-robot, buffer, twin, cellctl, order-desk, client
   std::vector<std::string> publish, subscribe;
 };
 
 // One per process of the cell (cell-sim, each station, robot and buffer), one for every twin
-// ("twin") and one for cellctl, the operator's observer.
+// ("twin"), one for cellctl, the operator's observer, one for cellctl up ("order-desk"), and
+// one per client of the file's `clients:`.
 std::vector<Grant> cell_grants(const CellConfig& cell);
 
 // Authenticated participants only; discovery, liveliness and every topic's data encrypted;

@@ -1,0 +1,262 @@
+#include "deploy/cellctl/remote_desk.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <optional>
+
+#include "twin/description/automationml/automationml_description.hpp"
+#include "twin/description/product_description.hpp"
+#include "twin/model/source_ref.hpp"
+
+namespace cellctl {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kUploadsPerClient = 4;  // submissions whose files arrive at once
+
+std::string text_of(cell::DeskState s) {
+  switch (s) {
+    case cell::DESK_ACCEPTED: return "accepted";
+    case cell::DESK_REFUSED: return "refused";
+    case cell::DESK_PROGRESS: return "progress";
+    case cell::DESK_DONE: return "done";
+    case cell::DESK_FAILED: return "failed";
+  }
+  return "?";
+}
+
+// "a.aml:12: ..." instead of "/var/.../desk/oem-a/7/product/a.aml:12: ...": the client knows
+// its files by their names.
+std::string relative_to(std::string message, const fs::path& folder) {
+  const std::string prefix = folder.string() + "/";
+  for (auto at = message.find(prefix); at != std::string::npos; at = message.find(prefix)) message.erase(at, prefix.size());
+  return message;
+}
+
+bool good_submission(const std::string& s) {
+  return !s.empty() && s.size() <= 64 &&
+         s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") == std::string::npos &&
+         s.front() != '.';
+}
+
+}  // namespace
+
+struct RemoteDesk::Client {
+  std::string id;
+  std::mutex mutex;  // guards uploads and requests (DDS threads add, tend() takes)
+  std::map<std::string, FileAssembly> uploads;
+  std::map<std::string, std::string> upload_errors;  // submission -> why its files were refused
+  std::deque<std::string> upload_order;              // oldest first
+  std::deque<cell::OrderRequest> requests;
+  std::deque<std::chrono::steady_clock::time_point> accepted_at;  // the last minute's
+  std::unique_ptr<dds::Reader<cell::FileChunk, cell::FileChunkPubSubType>> files;
+  std::unique_ptr<dds::Reader<cell::OrderRequest, cell::OrderRequestPubSubType>> orders;
+  std::unique_ptr<dds::Writer<cell::DeskReply, cell::DeskReplyPubSubType>> replies;
+  std::unique_ptr<ChunkWriter> results;
+
+  void take_chunk(const cell::FileChunk& chunk, std::uint64_t max_bytes) {
+    const std::string submission = chunk.submission().to_string();
+    std::lock_guard<std::mutex> lock(mutex);
+    if (upload_errors.count(submission)) return;
+    auto it = uploads.find(submission);
+    if (it == uploads.end()) {
+      if (!good_submission(submission)) return;  // answered when its order comes
+      while (upload_order.size() >= kUploadsPerClient) {  // an upload never finished: the oldest goes
+        uploads.erase(upload_order.front());
+        upload_order.pop_front();
+      }
+      it = uploads.emplace(submission, FileAssembly(max_bytes)).first;
+      upload_order.push_back(submission);
+    }
+    if (const std::string why = it->second.add(chunk); !why.empty()) {
+      upload_errors[submission] = why;
+      uploads.erase(it);
+      upload_order.erase(std::find(upload_order.begin(), upload_order.end(), submission));
+    }
+  }
+};
+
+RemoteDesk::RemoteDesk(const CellConfig& cell, state::CellStore& store, CellObserver& observer,
+                       std::function<void(const std::string&)> log)
+    : cell_(cell), store_(store), observer_(observer), log_(std::move(log)) {
+  const auto max_bytes = static_cast<std::uint64_t>(cell.desk.max_order_mb * 1e6);
+  const dds::ParticipantPtr& participant = observer.participant();
+  for (const auto& id : cell.clients) {
+    auto client = std::make_unique<Client>();
+    Client* c = client.get();
+    c->id = id;
+    c->replies = std::make_unique<dds::Writer<cell::DeskReply, cell::DeskReplyPubSubType>>(
+        participant, desk_topic("replies", id), dds::TopicKind::state);
+    c->results = std::make_unique<ChunkWriter>(participant, desk_topic("results", id), dds::TopicKind::events, chunk_qos());
+    c->files = std::make_unique<dds::Reader<cell::FileChunk, cell::FileChunkPubSubType>>(
+        participant, desk_topic("files", id), dds::TopicKind::events,
+        [c, max_bytes](const cell::FileChunk& chunk) { c->take_chunk(chunk, max_bytes); },
+        std::function<void(const cell::FileChunk&)>{}, chunk_qos());
+    c->orders = std::make_unique<dds::Reader<cell::OrderRequest, cell::OrderRequestPubSubType>>(
+        participant, desk_topic("orders", id), dds::TopicKind::events, [c](const cell::OrderRequest& r) {
+          std::lock_guard<std::mutex> lock(c->mutex);
+          if (c->requests.size() < 64) c->requests.push_back(r);  // more waiting is a flood: dropped
+        });
+    clients_[id] = std::move(client);
+  }
+  // Orders of clients that a desk before this one took: followed to their end again.
+  for (const auto& known : store.orders()) {
+    const fs::path out(known.out);
+    const fs::path folder = out.parent_path();
+    if (known.ended() || out.filename() != "out" || folder.parent_path().parent_path() != cell.state_folder() / "desk") continue;
+    const std::string client = folder.parent_path().filename(), submission = folder.filename();
+    if (clients_.count(client)) accepted_.push_back({client, submission, known.order, ""});
+  }
+}
+
+RemoteDesk::~RemoteDesk() = default;
+
+void RemoteDesk::reply(Client& client, const std::string& submission, const std::string& order, cell::DeskState state,
+                       const std::string& message, double progress, unsigned result_files, int exit_code) {
+  cell::DeskReply r;
+  r.submission(submission);
+  r.order_id(order);
+  r.state(state);
+  r.message(message.substr(0, 1000));
+  r.progress(progress);
+  r.result_files(result_files);
+  r.exit_code(exit_code);
+  client.replies->write(r);
+}
+
+void RemoteDesk::refuse(Client& client, const std::string& submission, const std::string& why, int exit_code) {
+  log_("desk: refused " + client.id + "'s order " + submission + ": " + why);
+  store_.journal("desk", "refused", client.id + "/" + submission, why);
+  reply(client, submission, "", cell::DESK_REFUSED, why, 0, 0, exit_code);
+}
+
+void RemoteDesk::take_order(Client& client, const cell::OrderRequest& request) {
+  const std::string submission = request.submission().to_string();
+  if (!good_submission(submission)) {
+    return refuse(client, submission.substr(0, 64), "a submission id is 1 to 64 of A-Z, a-z, 0-9, ., _ and -", 2);
+  }
+  std::optional<FileAssembly> upload;
+  {
+    std::lock_guard<std::mutex> lock(client.mutex);
+    if (const auto e = client.upload_errors.find(submission); e != client.upload_errors.end()) {
+      const std::string why = e->second;
+      client.upload_errors.erase(e);
+      return refuse(client, submission, why, 2);
+    }
+    if (const auto u = client.uploads.find(submission); u != client.uploads.end()) {
+      upload = std::move(u->second);
+      client.uploads.erase(u);
+      client.upload_order.erase(std::find(client.upload_order.begin(), client.upload_order.end(), submission));
+    }
+  }
+  const std::string order = client.id + "-" + submission;
+  const auto now = std::chrono::steady_clock::now();
+  while (!client.accepted_at.empty() && now - client.accepted_at.front() > std::chrono::minutes(1)) client.accepted_at.pop_front();
+  if (static_cast<int>(client.accepted_at.size()) >= cell_.desk.orders_per_minute) {
+    return refuse(client, submission, "the desk takes " + std::to_string(cell_.desk.orders_per_minute) +
+                                          " orders a minute from a client; try again in a minute", 1);
+  }
+  const auto orders = store_.orders();
+  const auto under_way = std::count_if(orders.begin(), orders.end(), [](const auto& o) { return !o.ended(); });
+  if (under_way >= cell_.desk.max_orders) {
+    return refuse(client, submission, "the cell has " + std::to_string(under_way) + " orders under way, its limit; try again later", 1);
+  }
+  if (std::any_of(orders.begin(), orders.end(), [&](const auto& o) { return o.order == order; })) {
+    return refuse(client, submission, "the cell has an order " + order + " already: give this one another submission id", 2);
+  }
+  if (!upload) return refuse(client, submission, "no file of this submission came", 2);
+  const std::string product = request.product().to_string();
+  bool has_product = false;
+  for (const auto& f : request.files()) {
+    const std::string name = f.name().to_string();
+    const std::string* bytes = upload->complete(name);
+    if (!bytes) return refuse(client, submission, name + ": its chunks did not all come", 2);
+    if (bytes->size() != f.size() || sha256_hex(*bytes) != f.sha256().to_string()) {
+      return refuse(client, submission, name + ": its size or SHA-256 is not what the order says", 2);
+    }
+    has_product |= name == product;
+  }
+  if (!has_product) return refuse(client, submission, "the product " + product + " is not among the order's files", 2);
+
+  const fs::path folder = cell_.state_folder() / "desk" / client.id / submission;
+  std::error_code ignored;
+  fs::remove_all(folder, ignored);
+  for (const auto& f : request.files()) {
+    const fs::path file = folder / "product" / f.name().to_string();
+    fs::create_directories(file.parent_path());
+    std::ofstream(file, std::ios::binary) << *upload->complete(f.name().to_string());
+  }
+  try {
+    twin::build_product(twin::AutomationMLDescription(folder / "product" / product));
+  } catch (const twin::DescriptionError& e) {
+    fs::remove_all(folder, ignored);
+    return refuse(client, submission, relative_to(e.what(), folder / "product"), 2);
+  }
+  const std::string sequence = request.sequence_strategy().to_string().empty() ? "search" : request.sequence_strategy().to_string();
+  if (sequence != "search" && sequence != "paper") {
+    fs::remove_all(folder, ignored);
+    return refuse(client, submission, "sequence_strategy: '" + sequence + "' is none of search, paper", 2);
+  }
+  fs::create_directories(folder / "out");
+  if (!store_.submit_order({order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"})) {
+    return refuse(client, submission, "the cell has an order " + order + " already", 2);
+  }
+  client.accepted_at.push_back(now);
+  store_.journal("desk", "submitted", order, client.id + ": " + product + ", " + std::to_string(upload->bytes()) + " bytes");
+  log_("desk: " + client.id + "'s order " + submission + " accepted as " + order);
+  reply(client, submission, order, cell::DESK_ACCEPTED, "order " + order + " accepted");
+  accepted_.push_back({client.id, submission, order, ""});
+}
+
+void RemoteDesk::follow(Accepted& a) {
+  Client& client = *clients_.at(a.client);
+  const auto statuses = observer_.orders();
+  if (const auto s = statuses.find(a.order); s != statuses.end()) {
+    const std::string now = std::to_string(static_cast<int>(s->second.state())) + "|" + s->second.message().to_string();
+    if (now != a.last_state) {
+      a.last_state = now;
+      reply(client, a.submission, a.order, cell::DESK_PROGRESS, s->second.message().to_string(), s->second.progress());
+    }
+  }
+}
+
+void RemoteDesk::tend() {
+  for (auto& [id, client] : clients_) {
+    std::deque<cell::OrderRequest> requests;
+    {
+      std::lock_guard<std::mutex> lock(client->mutex);
+      requests.swap(client->requests);
+    }
+    for (const auto& r : requests) take_order(*client, r);
+  }
+  const auto orders = store_.orders();
+  for (auto it = accepted_.begin(); it != accepted_.end();) {
+    follow(*it);
+    const auto known = std::find_if(orders.begin(), orders.end(), [&](const auto& o) { return o.order == it->order; });
+    if (known == orders.end() || !known->ended() || known->exit_code < 0) {
+      ++it;
+      continue;
+    }
+    Client& client = *clients_.at(it->client);
+    std::vector<fs::path> results;
+    for (const auto& entry : fs::directory_iterator(fs::path(known->out))) {
+      if (entry.is_regular_file()) results.push_back(entry.path());
+    }
+    const bool done = known->state == "DONE";
+    reply(client, it->submission, it->order, done ? cell::DESK_DONE : cell::DESK_FAILED,
+          done ? "assembled" : known->reason, done ? 1 : 0, static_cast<unsigned>(results.size()), known->exit_code);
+    for (const auto& file : results) {
+      if (!send_file(*client.results, it->submission, file.filename().string(), read_file_bytes(file))) {
+        log_("desk: the results of " + it->order + " did not all go out to " + client.id + " (its reader fell behind)");
+        break;
+      }
+    }
+    log_("desk: " + it->order + " " + text_of(done ? cell::DESK_DONE : cell::DESK_FAILED) + "; " +
+         std::to_string(results.size()) + " result files sent to " + client.id);
+    it = accepted_.erase(it);
+  }
+}
+
+}  // namespace cellctl

@@ -1,0 +1,57 @@
+#pragma once
+// The order desk for remote clients, run by `cellctl up` (docs/order-desk.md): per client of
+// the deployment file's `clients:`, it takes a product's files in chunks and then the order
+// (idl/desk.idl), checks them (names, sizes, digests, the AutomationML description: the same
+// errors as `cellctl submit`, sent back), keeps them in the cell's state folder and hands the
+// order to the local desk (OrderDesk), which starts its twin. It relays the order's progress
+// and, at its end, sends the results (plan.json, animation.gltf) back. Past a limit of the
+// deployment file's `desk:` it refuses with the reason and goes on.
+//
+// DDS threads only queue what comes in; tend(), on cellctl up's loop, does the work: one
+// client's upload never stalls another client's reader.
+
+#include <chrono>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/cell_observer.hpp"
+#include "deploy/cellctl/file_transfer.hpp"
+#include "services/state/cell_store.hpp"
+
+namespace cellctl {
+
+class RemoteDesk {
+ public:
+  RemoteDesk(const CellConfig& cell, state::CellStore& store, CellObserver& observer,
+             std::function<void(const std::string&)> log);
+  ~RemoteDesk();
+
+  void tend();
+
+ private:
+  struct Client;
+  struct Accepted {  // an order of a client, until its results are sent
+    std::string client, submission, order;
+    std::string last_state;
+  };
+
+  void take_order(Client& client, const cell::OrderRequest& request);
+  void refuse(Client& client, const std::string& submission, const std::string& why, int exit_code);
+  void reply(Client& client, const std::string& submission, const std::string& order, cell::DeskState state,
+             const std::string& message, double progress = 0, unsigned result_files = 0, int exit_code = 0);
+  void follow(Accepted& order);  // relays its progress
+
+  const CellConfig& cell_;
+  state::CellStore& store_;
+  CellObserver& observer_;
+  std::function<void(const std::string&)> log_;
+  std::map<std::string, std::unique_ptr<Client>> clients_;
+  std::vector<Accepted> accepted_;
+};
+
+}  // namespace cellctl
