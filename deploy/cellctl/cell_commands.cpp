@@ -40,6 +40,7 @@ struct CellOptions {
   double wait_s = 30;
   std::string state_dir;
   std::string security_dir;
+  std::vector<std::string> interfaces, peers;
 
   CellConfig load() const;
 };
@@ -51,6 +52,8 @@ void add_cell_options(CLI::App* cmd, CellOptions& o) {
   cmd->add_option("--state-dir", o.state_dir, "Folder of the cell's database, instead of the file's state_dir");
   cmd->add_option("--security", o.security_dir, "DDS-Security: the folder `cellctl pki init` wrote, instead of the file's")
       ->check(CLI::ExistingDirectory);
+  cmd->add_option("--interface", o.interfaces, "Use this IPv4 address of the host (repeat), instead of the file's network");
+  cmd->add_option("--peer", o.peers, "Look for participants at this IPv4 address too (another host; repeat)");
 }
 
 fs::path pid_file(int domain) {
@@ -100,6 +103,8 @@ CellConfig CellOptions::load() const {
   if (domain >= 0) c.domain = domain;
   if (real_time_factor > 0) c.real_time_factor = real_time_factor;
   if (!security_dir.empty()) c.security_dir = fs::absolute(security_dir);
+  if (!interfaces.empty()) c.interfaces = interfaces;
+  if (!peers.empty()) c.peers = peers;
   if (!state_dir.empty()) {
     c.state_dir = state_dir;
   } else if (const std::string running = running_state_dir(c.domain); !running.empty()) {

@@ -170,7 +170,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk"});
+              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -198,6 +198,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, root, "state_dir", dir);
     if (dir.empty()) throw ConfigError(where(file, root["state_dir"]) + ": state_dir names a folder");
     c.state_dir = file.parent_path() / dir;
+  }
+  if (const YAML::Node network = root["network"]) {
+    known_keys(file, network, {"interfaces", "peers"});
+    read(file, network, "interfaces", c.interfaces);
+    read(file, network, "peers", c.peers);
+    if (c.interfaces.empty()) throw ConfigError(where(file, network) + ": network needs the host's interfaces (IPv4 addresses)");
   }
   read(file, root, "clients", c.clients);
   for (const auto& id : c.clients) {
@@ -272,7 +278,9 @@ std::filesystem::path CellConfig::state_folder() const {
 dds::ParticipantSettings CellConfig::participant_settings(const std::string& identity) const {
   dds::ParticipantSettings s;
   s.domain_id = domain;
-  s.localhost_only = localhost_only;
+  s.localhost_only = localhost_only && interfaces.empty();
+  s.interfaces = interfaces;
+  s.peers = peers;
   if (!security_dir.empty()) s.security = {security_dir, identity};
   return s;
 }
@@ -281,6 +289,12 @@ namespace {
 
 void add_security(std::vector<std::string>& argv, const CellConfig& c) {
   if (!c.security_dir.empty()) argv.insert(argv.end(), {"--security", c.security_dir.string()});
+}
+
+void add_network(std::vector<std::string>& argv, const CellConfig& c) {
+  for (const auto& a : c.interfaces) argv.insert(argv.end(), {"--interface", a});
+  for (const auto& a : c.peers) argv.insert(argv.end(), {"--peer", a});
+  if (c.interfaces.empty() && !c.localhost_only) argv.push_back("--all-interfaces");
 }
 
 }  // namespace
@@ -292,7 +306,7 @@ std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::p
                                 "--product", product, "--out", out, "--sequence", sequence, "--path", path, "--wait",
                                 std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--quiet"};
   if (!state_dir.empty()) argv.insert(argv.end(), {"--state-dir", state_dir.string()});
-  if (!c.localhost_only) argv.push_back("--all-interfaces");
+  add_network(argv, c);
   add_security(argv, c);
   add_gripper(argv, c.gripper);
   return argv;
@@ -339,7 +353,7 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
   }
   for (auto& p : out) {
     p.argv.insert(p.argv.end(), {"--state-dir", c.state_folder().string()});
-    if (!c.localhost_only) p.argv.push_back("--all-interfaces");
+    add_network(p.argv, c);
     add_security(p.argv, c);
   }
   return out;

@@ -58,6 +58,9 @@ struct CellConfig {
   double real_time_factor = 1;
   double liveliness_lease = 5;  // s: a process starved of CPU for 2 s is not taken for gone
   bool localhost_only = true;   // false: every process uses every network interface
+  // `network: {interfaces: [IP], peers: [IP]}`: instead, only these addresses of the host, and
+  // other hosts' to look for participants at (an OEM's client, the cell's other hosts).
+  std::vector<std::string> interfaces, peers;
   std::vector<StationConfig> stations{StationConfig{}};
   std::vector<RobotConfig> robots{RobotConfig{}};
   std::vector<BufferConfig> buffers;

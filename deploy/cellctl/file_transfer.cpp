@@ -67,7 +67,7 @@ std::string FileAssembly::add(const cell::FileChunk& chunk) {
   auto it = data_.find(name);
   if (it == data_.end()) {
     if (data_.size() >= static_cast<std::size_t>(cell::MAX_ORDER_FILES)) return "more than 256 files";
-    if (size > max_bytes_ - bytes_) return "the order's files pass the desk's limit of " + std::to_string(max_bytes_ / 1000000) + " MB";
+    if (size > max_bytes_ - bytes_) return "the order's files pass the desk's limit of " + std::to_string(max_bytes_) + " bytes (max_order_mb)";
     bytes_ += size;
     it = data_.emplace(name, std::string(size, '\0')).first;
     received_[name] = 0;

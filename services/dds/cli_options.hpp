@@ -1,7 +1,8 @@
 #pragma once
 // The DDS options every cell process takes: --domain N (required), --all-interfaces (the
-// deployment file's `localhost_only: false`; without it, loopback only), and --security DIR
-// with --identity NAME (the deployment file's `security: DIR`; docs/security.md).
+// deployment file's `localhost_only: false`; without it, loopback only) or --interface IP
+// and --peer IP (its `network:`), and --security DIR with --identity NAME (its
+// `security: DIR`; docs/security.md).
 
 #include <CLI/CLI.hpp>
 
@@ -15,6 +16,8 @@ namespace dds {
 inline void add_dds_options(CLI::App& app, ParticipantSettings& settings, bool& all_interfaces) {
   app.add_option("--domain", settings.domain_id, "DDS domain id")->required()->check(CLI::Range(0, 232));
   app.add_flag("--all-interfaces", all_interfaces, "Use every network interface, not only loopback");
+  app.add_option("--interface", settings.interfaces, "Use this IPv4 address of the host (repeat for more), not loopback");
+  app.add_option("--peer", settings.peers, "Look for participants at this IPv4 address too (another host; repeat)");
   app.add_option("--security", settings.security.dir, "DDS-Security: the folder `cellctl pki init` wrote (default: off)");
   app.add_option("--identity", settings.security.identity,
                  "DDS-Security: the identity under DIR/identities (default: the process's name)");
@@ -52,7 +55,7 @@ inline fb::CellBounds apply_bounds(const std::vector<double>& values) {
 }
 
 inline void apply_interfaces(ParticipantSettings& settings, bool all_interfaces) {
-  settings.localhost_only = !all_interfaces;
+  settings.localhost_only = !all_interfaces && settings.interfaces.empty();
 }
 
 }  // namespace dds

@@ -88,24 +88,36 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   using namespace eprosima::fastdds::dds;
   DomainParticipantQos qos = PARTICIPANT_QOS_DEFAULT;
   qos.name(name);
+  // The addresses to use and to look for others at: loopback, or the deployment's network.
+  std::vector<std::string> interfaces, peers;
   if (settings.localhost_only) {
-    // UDP on loopback only, no shared memory: Fast DDS 2.9.1's SHM transport drops messages
-    // silently (a full port, a port of a process killed hard whose number a new process
-    // reuses, a sender's full segment) and, once two processes see each other's SHM
+    interfaces = peers = {"127.0.0.1"};
+  } else if (!settings.interfaces.empty()) {
+    interfaces = peers = settings.interfaces;  // the other processes on this host
+    peers.insert(peers.end(), settings.peers.begin(), settings.peers.end());
+  }
+  if (!interfaces.empty()) {
+    // UDP on those addresses only, no shared memory: Fast DDS 2.9.1's SHM transport drops
+    // messages silently (a full port, a port of a process killed hard whose number a new
+    // process reuses, a sender's full segment) and, once two processes see each other's SHM
     // locators, carries their discovery over SHM alone. Lost discovery and liveliness
     // messages were the multi-second discovery tail and a live buffer declared gone.
     qos.transport().use_builtin_transports = false;
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-    udp->interfaceWhiteList.emplace_back("127.0.0.1");
-    // The initial peer 127.0.0.1 stands for the discovery ports of participants 0..N-1 on
-    // this host; Fast DDS's default N is 4, and a cell has more processes than that (the
-    // sixth one was never discovered). 32 covers a cell, its twins and cellctl.
+    for (const auto& address : interfaces) udp->interfaceWhiteList.emplace_back(address);
+    // An initial peer stands for the discovery ports of participants 0..N-1 at its address;
+    // Fast DDS's default N is 4, and a cell has more processes than that (the sixth one was
+    // never discovered). 32 covers a cell, its twins and cellctl.
     udp->maxInitialPeersRange = kMaxParticipantsPerHost;
     qos.transport().user_transports.push_back(udp);
-    eprosima::fastrtps::rtps::Locator_t peer;
-    peer.kind = LOCATOR_KIND_UDPv4;
-    eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, "127.0.0.1");
-    qos.wire_protocol().builtin.initialPeersList.push_back(peer);
+    for (const auto& address : peers) {
+      eprosima::fastrtps::rtps::Locator_t peer;
+      peer.kind = LOCATOR_KIND_UDPv4;
+      if (!eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, address)) {
+        throw std::runtime_error("DDS participant '" + name + "': '" + address + "' is not an IPv4 address");
+      }
+      qos.wire_protocol().builtin.initialPeersList.push_back(peer);
+    }
   }
   // Announce the participant every 0.5 s instead of 3 s: a first announcement that no one
   // heard (a process starting while others start) otherwise delays discovery by seconds.

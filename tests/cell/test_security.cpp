@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <set>
 
@@ -14,6 +15,7 @@
 
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
+#include "deskPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "tests/support/cell_test.hpp"
 
@@ -205,4 +207,61 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
   CHECK(order == 0);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("order desk: a client submits over DDS-Security and gets its results, past a limit or with a bad description it is refused with the reason, and it reads no other client's orders",
+          "[process][security][desk]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("order-desk");
+  const std::string domain = "226";
+  // The default cell, with a desk that takes 50 kB (the Lego tower, not Cranfield) and one
+  // order a minute per client.
+  std::string yaml = test::read_text(DEFAULT_CELL);
+  yaml.replace(yaml.find("max_order_mb: 64"), 16, "max_order_mb: 0.05");
+  yaml.replace(yaml.find("orders_per_minute: 6"), 20, "orders_per_minute: 1");
+  const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
+  std::ofstream(cell) << yaml;
+  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
+  test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--security", pki.string(),
+                         "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
+                        (dir / "up.log").string());
+  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+  const auto submit = [&](const std::string& client, const std::string& product, const std::string& id) {
+    return test::cellctl({"submit", "--remote", "--client", client, product, "--cell", cell.string(), "--domain", domain,
+                          "--security", pki.string(), "--order", id, "--out", (dir / id).string()},
+                         dir / (id + ".log"));
+  };
+
+  const int lego = submit("oem-a", kLego, "tower");
+  {
+    INFO(test::read_text(dir / "tower.log") << test::read_text(dir / "up.log"));
+    REQUIRE(lego == 0);
+  }
+  CHECK(test::read_text(dir / "tower" / "plan.json").find("\"complete\": true") != std::string::npos);
+  CHECK(fs::file_size(dir / "tower" / "animation.gltf") > 1000);
+  CHECK(fs::exists(dir / "state" / "desk" / "oem-a" / "tower" / "product" / "lego-tower.aml"));
+
+  const auto refused = [&](const std::string& id, int code, const std::string& why) {
+    const std::string log = test::read_text(dir / (id + ".log"));
+    INFO(log);
+    CHECK(log.find("the desk refused the order: " + why) != std::string::npos);
+    return code;
+  };
+  CHECK(refused("big", submit("oem-b", std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "big"), "the order's files pass the desk's limit of 50000 bytes") == 2);
+  CHECK(refused("bad", submit("oem-b", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "bad"), "unknown_link_id.aml:") == 2);
+  CHECK(refused("again", submit("oem-a", kLego, "again"), "the desk takes 1 orders a minute from a client") == 1);
+  CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-b" / "bad"));  // nothing kept of a refused order
+
+  // oem-b's certificate reads its own answers, not oem-a's, nor the cell's order status.
+  auto oem_b = dds::make_participant("test-oem-b", {std::stoi(domain), true, {pki, "oem-b"}});
+  const auto reader_on = [&](const std::string& topic) {
+    dds::Reader<cell::DeskReply, cell::DeskReplyPubSubType> r(oem_b, topic, dds::TopicKind::state, [](const cell::DeskReply&) {});
+  };
+  CHECK_NOTHROW(reader_on("cell/desk/replies/oem-b"));
+  CHECK_THROWS_WITH(reader_on("cell/desk/replies/oem-a"), Catch::Contains("permissions do not allow it"));
+  CHECK_THROWS_WITH(reader_on("cell/orders/status"), Catch::Contains("permissions do not allow it"));
+
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+  CHECK(test::read_text(dir / "up.log").find("refused oem-b's order big") != std::string::npos);
 }

@@ -1,0 +1,120 @@
+// Two hosts for real: two network namespaces joined by a veth pair (`ip netns`, as root). The
+// cell runs in one with DDS-Security, on the veth address only (the deployment file's
+// `network:`); an OEM in the other submits Cranfield to its order desk and gets the plan and
+// the animation back. No traffic leaves the two namespaces. Exits 77 (ctest: skipped) with
+// the reason where namespaces cannot be made (not root, no `ip`, no netns support).
+
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
+#define CATCH_CONFIG_RUNNER
+#include <catch2/catch.hpp>
+
+#include "tests/support/cell_test.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+// Names and addresses of this run's namespaces (the pid keeps parallel runs apart).
+struct Net {
+  std::string tag = std::to_string(::getpid() % 100000);
+  std::string cell_ns = "agc-cell-" + tag, oem_ns = "agc-oem-" + tag;
+  std::string cell_if = "agcc" + tag, oem_if = "agco" + tag;
+  std::string subnet = "10.231." + std::to_string(::getpid() % 250) + ".";
+  std::string cell_ip = subnet + "1", oem_ip = subnet + "2";
+};
+
+int sh(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()); }
+
+// Makes the two namespaces and the veth pair; deletes them (and what runs in them) at the end.
+class TwoHosts {
+ public:
+  TwoHosts() {
+    const Net& n = net_;
+    ok_ = sh("ip netns add " + n.cell_ns) == 0 && sh("ip netns add " + n.oem_ns) == 0 &&
+          sh("ip link add " + n.cell_if + " type veth peer name " + n.oem_if) == 0 &&
+          sh("ip link set " + n.cell_if + " netns " + n.cell_ns) == 0 && sh("ip link set " + n.oem_if + " netns " + n.oem_ns) == 0 &&
+          sh("ip -n " + n.cell_ns + " addr add " + n.cell_ip + "/24 dev " + n.cell_if) == 0 &&
+          sh("ip -n " + n.oem_ns + " addr add " + n.oem_ip + "/24 dev " + n.oem_if) == 0 &&
+          sh("ip -n " + n.cell_ns + " link set " + n.cell_if + " up") == 0 &&
+          sh("ip -n " + n.oem_ns + " link set " + n.oem_if + " up") == 0 && sh("ip -n " + n.cell_ns + " link set lo up") == 0 &&
+          sh("ip -n " + n.oem_ns + " link set lo up") == 0;
+  }
+  ~TwoHosts() {
+    for (const auto& ns : {net_.cell_ns, net_.oem_ns}) {
+      sh("ip netns pids " + ns + " | xargs -r kill -9");
+      sh("ip netns del " + ns);
+    }
+  }
+  bool ok() const { return ok_; }
+  const Net& net() const { return net_; }
+
+ private:
+  Net net_;
+  bool ok_ = false;
+};
+
+}  // namespace
+
+TEST_CASE("two hosts: an OEM in one network namespace submits Cranfield to a secure cell in another and gets the plan and the animation",
+          "[process][security][desk][network]") {
+  test::clean_stale_dds_segments();
+  TwoHosts hosts;
+  REQUIRE(hosts.ok());
+  const Net& n = hosts.net();
+  const fs::path dir = test::scratch("two-hosts");
+  const std::string domain = "227";
+  const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
+  std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nnetwork: {interfaces: [" << n.cell_ip << "], peers: [" << n.oem_ip
+                      << "]}\nsecurity: pki\n";
+  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
+
+  test::ChildProcess up({"/usr/sbin/ip", "netns", "exec", n.cell_ns, CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain,
+                         "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
+                        (dir / "up.log").string());
+  {
+    INFO(test::read_text(dir / "up.log"));
+    REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+  }
+  // The OEM has its own folder: the CA's certificate, the governance and its identity only.
+  const fs::path oem = dir / "oem-a";
+  fs::create_directories(oem / "identities");
+  fs::copy(pki / "ca.cert.pem", oem);
+  fs::copy(pki / "governance.p7s", oem);
+  fs::copy(pki / "identities" / "oem-a", oem / "identities" / "oem-a", fs::copy_options::recursive);
+
+  test::ChildProcess submit({"/usr/sbin/ip", "netns", "exec", n.oem_ns, CELLCTL_EXE, "submit", "--remote", "--client", "oem-a",
+                             std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "--domain", domain, "--security",
+                             oem.string(), "--interface", n.oem_ip, "--peer", n.cell_ip, "--order", "remote", "--out",
+                             (dir / "remote").string()},
+                            (dir / "submit.log").string());
+  const int code = submit.wait_for_exit(180s);
+  INFO(test::read_text(dir / "submit.log") << test::read_text(dir / "up.log"));
+  CHECK(code == 0);
+  CHECK(test::read_text(dir / "remote" / "plan.json").find("\"complete\": true") != std::string::npos);
+  CHECK(fs::file_size(dir / "remote" / "animation.gltf") > 1000);
+  CHECK(test::read_text(dir / "submit.log").find("assembled 9 parts") != std::string::npos);
+
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+int main(int argc, char** argv) {
+  if (::geteuid() != 0) {
+    std::cout << "skipped: making network namespaces needs root\n";
+    return 77;
+  }
+  const std::string probe = "agc-probe-" + std::to_string(::getpid());
+  if (sh("ip netns add " + probe) != 0) {
+    std::cout << "skipped: `ip netns add` does not work here\n";
+    return 77;
+  }
+  sh("ip netns del " + probe);
+  return Catch::Session().run(argc, argv);
+}
