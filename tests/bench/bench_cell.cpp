@@ -23,50 +23,22 @@
 #include "commandsPubSubTypes.h"
 #include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
+#include "tests/bench/bench_support.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/hire.hpp"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
+using bench::Clock;
+using bench::report;
 
 // Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
 std::atomic<bool> running{true};
 void stop(int) { running = false; }
 
-using CommandWriter = dds::Writer<cell::Command, cell::CommandPubSubType>;
-using CommandReader = dds::Reader<cell::Command, cell::CommandPubSubType>;
 using EventWriter = dds::Writer<cell::CommandEvent, cell::CommandEventPubSubType>;
-using EventReader = dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>;
-
-// Waits for the answer to each request, one at a time.
-struct Answers {
-  std::mutex mutex;
-  std::condition_variable arrived;
-  std::string last;
-  void answer(const std::string& id) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      last = id;
-    }
-    arrived.notify_all();
-  }
-  bool wait(const std::string& id) {
-    std::unique_lock<std::mutex> lock(mutex);
-    return arrived.wait_for(lock, 5s, [&] { return last == id; });
-  }
-};
-
-double percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * v.size()))];
-}
-
-void report(const std::string& what, const std::vector<double>& us) {
-  std::cout << what << ": p50 " << percentile(us, 0.5) << " us, p99 " << percentile(us, 0.99) << " us (" << us.size()
-            << " rounds)" << std::endl;
-}
+using CommandReader = dds::Reader<cell::Command, cell::CommandPubSubType>;
 
 int echo(int domain) {
   std::signal(SIGTERM, stop);
@@ -87,28 +59,17 @@ int echo(int domain) {
 std::vector<double> round_trips(const dds::ParticipantPtr& participant, const std::string& topic,
                                 const std::string& answers_topic, const std::string& resource, int rounds,
                                 const std::string& award = "") {
-  Answers answers;
-  EventReader reader(participant, answers_topic, dds::TopicKind::events, [&](const cell::CommandEvent& e) {
-    if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id().to_string());
-  });
-  CommandWriter writer(participant, topic, dds::TopicKind::events);
-  if (!writer.wait_for_readers(1, 20s)) throw std::runtime_error("nobody reads " + topic);
-  std::this_thread::sleep_for(300ms);  // the reader's side of the match, too
-  std::vector<double> us;
-  for (int i = -20; i < rounds; ++i) {  // 20 warm-up rounds
+  return bench::round_trips(participant, participant, topic, answers_topic, rounds, [&](int i) {
     cell::Command c;
-    c.command_id(resource + "-" + std::to_string(i + 100));
+    c.command_id(resource + "-" + std::to_string(i));
     c.resource_id(resource);
     c.order_id("bench");
     c.award(award);
     c.operation("give");
     c.part_type("Part");
-    const auto start = Clock::now();
-    writer.write(c);
-    if (!answers.wait(c.command_id().to_string())) throw std::runtime_error("no answer to " + c.command_id().to_string());
-    if (i >= 0) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-  }
-  return us;
+    c.destination("bench");  // a give names who takes the part
+    return c;
+  });
 }
 
 // With cell-sim and a station running (the twin needs both before virtual assembly).
