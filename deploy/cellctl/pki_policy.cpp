@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "deploy/cellctl/file_transfer.hpp"
+#include "services/dds/endpoints.hpp"
 
 namespace cellctl::pki {
 
@@ -24,7 +25,7 @@ const Topics kEveryone = {"cell/reader_slots"};
 // events, bids and award replies; it reads calls, awards, releases, cancels, the orders'
 // status and the clock.
 Grant resource(const std::string& id, const std::string& role, const Topics& own_command_topics, bool moves) {
-  Grant g{id, role,
+  Grant g{id, role, {id},
           {"cell/capabilities", "cell/command_events", "cell/negotiation/proposals", "cell/negotiation/replies"},
           own_command_topics + Topics{"cell/cancel_requests", "cell/negotiation/calls", "cell/negotiation/awards",
                                       "cell/negotiation/releases", "cell/orders/status", "cell/clock"} + kEveryone};
@@ -35,22 +36,38 @@ Grant resource(const std::string& id, const std::string& role, const Topics& own
   return g;
 }
 
-void topics_xml(std::ostream& out, const char* tag, const Topics& topics) {
+void criteria_xml(std::ostream& out, const char* tag, const Topics& topics, const Topics& partitions) {
   if (topics.empty()) return;
   out << "        <" << tag << ">\n          <topics>\n";
   for (const auto& t : topics) out << "            <topic>" << t << "</topic>\n";
-  out << "          </topics>\n        </" << tag << ">\n";
+  out << "          </topics>\n";
+  if (!partitions.empty()) {
+    out << "          <partitions>\n";
+    for (const auto& p : partitions) out << "            <partition>" << p << "</partition>\n";
+    out << "          </partitions>\n";
+  }
+  out << "        </" << tag << ">\n";
+}
+
+// The owned topics (dds::owned_topic) in the identity's own partitions when it writes them,
+// in every partition when it reads them; the others in the default partition.
+void topics_xml(std::ostream& out, const char* tag, const Topics& topics, const Topics& owned_partitions) {
+  Topics owned, other;
+  for (const auto& t : topics) (dds::owned_topic(t) ? owned : other).push_back(t);
+  criteria_xml(out, tag, other, {});
+  criteria_xml(out, tag, owned, owned_partitions);
 }
 
 }  // namespace
 
 std::vector<Grant> cell_grants(const CellConfig& cell) {
   std::vector<Grant> grants;
-  grants.push_back({"cell-sim", "cell-sim", {"cell/sim/replies", "cell/clock", "cell/capabilities"},
+  grants.push_back({"cell-sim", "cell-sim", {"cell-sim"}, {"cell/sim/replies", "cell/clock", "cell/capabilities"},
                     Topics{"cell/sim/requests", "cell/negotiation/replies", "cell/orders/status"} + kEveryone});
   Topics commanded;  // what a twin commands: the arms and the robots
   for (const auto& s : cell.stations) {
     grants.push_back(resource(s.id, "station", {commands(s.id), commands(s.arm)}, true));
+    grants.back().own_partitions.push_back(s.arm);  // the arm is a resource of the station's process
     commanded.push_back(commands(s.arm));
   }
   Topics buffers;
@@ -65,21 +82,21 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
     grants.push_back(g);
     commanded.push_back(commands(r.id));
   }
-  grants.push_back({"twin", "twin",
+  grants.push_back({"twin", "twin", {},
                     Topics{"cell/orders/status", "cell/orders/result", "cell/negotiation/calls", "cell/negotiation/awards",
                            "cell/negotiation/releases", "cell/cancel_requests", "cell/sim/requests"} + commanded,
                     Topics{"cell/clock", "cell/capabilities", "cell/negotiation/proposals", "cell/negotiation/replies",
                            "cell/command_events", "cell/sim/replies"} + kEveryone});
   const Topics observer = Topics{"cell/clock", "cell/capabilities", "cell/orders/status", "cell/orders/result",
                                  "cell/command_events"} + kEveryone;
-  grants.push_back({"cellctl", "cellctl", {}, observer});
+  grants.push_back({"cellctl", "cellctl", {}, {}, observer});
   // cellctl up: it observes the cell and runs the order desk of every client.
-  Grant desk{"order-desk", "order-desk", {}, observer};
+  Grant desk{"order-desk", "order-desk", {}, {}, observer};
   for (const auto& c : cell.clients) {
     desk.publish = desk.publish + Topics{desk_topic("replies", c), desk_topic("results", c)};
     desk.subscribe = desk.subscribe + Topics{desk_topic("files", c), desk_topic("orders", c)};
     // A client sends its orders and reads its own answers: nothing of the cell, nor of others.
-    grants.push_back({c, "client", {desk_topic("files", c), desk_topic("orders", c)},
+    grants.push_back({c, "client", {}, {desk_topic("files", c), desk_topic("orders", c)},
                       Topics{desk_topic("replies", c), desk_topic("results", c)} + kEveryone});
   }
   grants.push_back(desk);
@@ -136,8 +153,8 @@ std::string permissions_xml(const Grant& grant, int domain, const Validity& vali
           <id>)" << domain << R"(</id>
         </domains>
 )";
-  topics_xml(out, "publish", grant.publish);
-  topics_xml(out, "subscribe", grant.subscribe);
+  topics_xml(out, "publish", grant.publish, grant.own_partitions);
+  topics_xml(out, "subscribe", grant.subscribe, {"*"});
   out << R"(      </allow_rule>
       <default>DENY</default>
     </grant>

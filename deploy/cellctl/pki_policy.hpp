@@ -14,6 +14,7 @@ namespace cellctl::pki {
 struct Grant {
   std::string identity;  // the certificate's CN and its folder under DIR/identities
   std::string role;      // cell-sim, station, mobile-robot, buffer, twin, cellctl, order-desk, client
+  std::vector<std::string> own_partitions;  // the ids it writes its capability and command events as
   std::vector<std::string> publish, subscribe;
 };
 

@@ -37,6 +37,25 @@ namespace fdds = eprosima::fastdds::dds;
 // in its reader) another resource's commands.
 inline std::string command_topic(const std::string& resource_id) { return "cell/commands/" + resource_id; }
 
+// Topics every resource writes about itself (its capability, its commands' events). Each
+// writes them in a DDS partition named after its id, and their readers read every partition
+// (the default one too: a process or a test that writes with none is still heard):
+// DDS-Security permissions then let a resource write its own and no other's
+// (deploy/cellctl/pki_policy.cpp).
+inline bool owned_topic(const std::string& topic) { return topic == "cell/capabilities" || topic == "cell/command_events"; }
+
+// Settings with the partition(s) `owner` writes an owned topic in.
+inline QosSettings owned_by(std::vector<std::string> owner, QosSettings settings = {}) {
+  settings.partitions = std::move(owner);
+  return settings;
+}
+
+template <class Qos>
+Qos with_partitions(Qos qos, const std::vector<std::string>& partitions) {
+  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
+  return qos;
+}
+
 // Why Fast DDS refused an endpoint, as far as we know: under DDS-Security, the identity's
 // permissions (Fast DDS logs which rule), else nothing more to say.
 inline std::string refusal_reason(const fdds::DomainParticipant& participant) {
@@ -62,7 +81,7 @@ class Writer : private fdds::DataWriterListener {
  public:
   Writer(ParticipantPtr participant, const std::string& topic, TopicKind kind, const QosSettings& settings = {})
       : participant_(std::move(participant)) {
-    publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    publisher_ = participant_->create_publisher(with_partitions(fdds::PUBLISHER_QOS_DEFAULT, settings.partitions));
     writer_ = publisher_->create_datawriter(topic_on<PubSubType>(*participant_, topic), writer_qos(kind, settings), this);
     if (!writer_) throw std::runtime_error("cannot create a writer on " + topic + refusal_reason(*participant_));
   }
@@ -177,7 +196,9 @@ class Reader : private fdds::DataReaderListener {
   Reader(ParticipantPtr participant, const std::string& topic, TopicKind kind, std::function<void(const T&)> on_sample,
          std::function<void(const T&)> on_gone = {}, const QosSettings& settings = {})
       : participant_(std::move(participant)), kind_(kind), on_sample_(std::move(on_sample)), on_gone_(std::move(on_gone)) {
-    subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    const std::vector<std::string> every{"*", ""};  // "*" matches no writer of the default partition
+    subscriber_ = participant_->create_subscriber(
+        with_partitions(fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && owned_topic(topic) ? every : settings.partitions));
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
   }

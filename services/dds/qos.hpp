@@ -10,6 +10,9 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include <string>
+#include <vector>
+
 namespace dds {
 
 enum class TopicKind { state, events };
@@ -19,6 +22,9 @@ struct QosSettings {
   // Events: samples a reader holds before it has taken them, and a writer before every reader
   // has them. Buffers grow to this and never shrink.
   int max_queued = 4096;
+  // The DDS partitions of the endpoint's publisher or subscriber; empty: the default one
+  // (a reader of an owned topic: every partition; see owned_topic()).
+  std::vector<std::string> partitions;
 };
 
 // A resource's command topic: one reader, commanded one step at a time by the orders that

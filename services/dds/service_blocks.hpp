@@ -28,9 +28,10 @@ class PublishBlock : public fb::FunctionBlock {
  public:
   using ToSample = std::function<T(const fb::Data&)>;
 
-  PublishBlock(std::string name, ParticipantPtr participant, const std::string& topic, TopicKind kind, ToSample to_sample)
+  PublishBlock(std::string name, ParticipantPtr participant, const std::string& topic, TopicKind kind, ToSample to_sample,
+               const QosSettings& settings = {})
       : FunctionBlock(std::move(name)),
-        writer_(std::make_unique<Outbox<T, PubSubType>>(std::move(participant), topic, kind)),
+        writer_(std::make_unique<Outbox<T, PubSubType>>(std::move(participant), topic, kind, settings)),
         to_sample_(std::move(to_sample)) {
     declare_input("REQ");
     declare_output("CNF");

@@ -106,7 +106,9 @@ struct ResourceNode::Impl {
   }
   template <class T, class P>
   void publish(const std::string& name, const std::string& topic, typename Pub<T, P>::ToSample to_sample) {
-    resource.add(std::make_unique<Pub<T, P>>(name, participant, topic, TopicKind::events, std::move(to_sample)));
+    // What a resource writes about itself goes in its partition (dds::owned_topic).
+    const dds::QosSettings settings = dds::owned_topic(topic) ? dds::owned_by({config.id}) : dds::QosSettings{};
+    resource.add(std::make_unique<Pub<T, P>>(name, participant, topic, TopicKind::events, std::move(to_sample), settings));
   }
 
   void publish_capability() {
@@ -246,7 +248,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   dds::QosSettings qos;
   qos.liveliness_lease_s = n.config.liveliness_lease_s;
   n.capabilities = std::make_unique<dds::Writer<cell::Capability, cell::CapabilityPubSubType>>(
-      participant, "cell/capabilities", TopicKind::state, qos);
+      participant, "cell/capabilities", TopicKind::state, dds::owned_by({n.config.id}, qos));
 
   // Commands and their life cycle.
   const std::string dev = device.name();
@@ -261,7 +263,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
       [me](const cell::Command& c) { return c.resource_id().to_string() == me ? dds::to_data(c) : fb::Data{}; },
       dds::command_qos());
   n.overflow_answers = std::make_unique<dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType>>(
-      participant, "cell/command_events", TopicKind::events);
+      participant, "cell/command_events", TopicKind::events, dds::owned_by({n.config.id}));
   commands.on_refused([&n](const cell::Command& c, const std::string& why) {
     cell::CommandEvent e;
     e.command_id(c.command_id());

@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
           c.refused_commands(static_cast<int32_t>(fb::get_or<std::int64_t>(d, "refused", 0)));
           c.last_refusal(fb::get_or<std::string>(d, "last_refusal", "").substr(0, cell::Text::max_size - 1));
           return c;
-        }));
+        },
+        dds::owned_by({"cell-sim"})));
     resource.connect("world", "REFUSED", "status", "REQ");
     resource.post("status", "REQ");
     requests.start();

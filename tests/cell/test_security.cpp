@@ -158,7 +158,8 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     CHECK(test::appears(dir / "up.log", "refused DDS participant", 10s));
   }
 
-  {  // A twin's certificate cannot publish a capability, nor a buffer's read another's commands.
+  {  // A twin's certificate cannot publish a capability; a buffer's cannot publish another
+     // buffer's capability (its partition), nor read its commands.
     const int as_twin = buffer_exit(domain, {"--id", "buffer-7", "--security", pki.string(), "--identity", "twin"}, dir / "twin.log");
     const std::string twin_log = test::read_text(dir / "twin.log");
     INFO(twin_log);
@@ -169,8 +170,13 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     const std::string other_log = test::read_text(dir / "other.log");
     INFO(other_log);
     CHECK(other != 0);
-    CHECK(other_log.find("cannot create a reader on cell/commands/buffer-1") != std::string::npos);
+    CHECK(other_log.find("cannot create a writer on cell/capabilities: this identity's DDS-Security permissions do not allow it") !=
+          std::string::npos);
     CHECK(trusted_sees.seen().count("buffer-7") == 0);
+    auto as_buffer_2 = dds::make_participant("test-buffer-2", {std::stoi(domain), true, {pki, "buffer-2"}});
+    CHECK_THROWS_WITH((dds::Reader<cell::Command, cell::CommandPubSubType>(as_buffer_2, dds::command_topic("buffer-1"),
+                                                                           dds::TopicKind::events, [](const cell::Command&) {})),
+                      Catch::Contains("cannot create a reader on cell/commands/buffer-1: this identity's DDS-Security"));
   }
 
   {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.
