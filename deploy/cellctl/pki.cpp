@@ -16,6 +16,7 @@
 #include <openssl/pkcs7.h>
 #include <openssl/x509v3.h>
 
+#include "services/dds/openssl_handles.hpp"
 #include "services/dds/security.hpp"
 
 namespace cellctl::pki {
@@ -24,27 +25,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-template <typename T, void (*Free)(T*)>
-struct Deleter {
-  void operator()(T* p) const { Free(p); }
-};
-using X509Ptr = std::unique_ptr<X509, Deleter<X509, X509_free>>;
-using KeyPtr = std::unique_ptr<EVP_PKEY, Deleter<EVP_PKEY, EVP_PKEY_free>>;
-using BioPtr = std::unique_ptr<BIO, Deleter<BIO, BIO_free_all>>;
-using Pkcs7Ptr = std::unique_ptr<PKCS7, Deleter<PKCS7, PKCS7_free>>;
-using BnPtr = std::unique_ptr<BIGNUM, Deleter<BIGNUM, BN_free>>;
+using openssl::BioPtr;
+using openssl::KeyPtr;
+using openssl::text_of;
+using openssl::X509Ptr;
+using Pkcs7Ptr = std::unique_ptr<PKCS7, openssl::Deleter<PKCS7, PKCS7_free>>;
+using BnPtr = std::unique_ptr<BIGNUM, openssl::Deleter<BIGNUM, BN_free>>;
 
 [[noreturn]] void fail(const std::string& what) {
   const unsigned long code = ERR_get_error();
   char reason[256] = "";
   if (code) ERR_error_string_n(code, reason, sizeof reason);
   throw PkiError("pki: " + what + (code ? std::string(": ") + reason : ""));
-}
-
-std::string text_of(BIO* bio) {
-  char* data = nullptr;
-  const long n = BIO_get_mem_data(bio, &data);
-  return std::string(data, static_cast<std::size_t>(n));
 }
 
 // Creates or replaces `file` with `mode` (a key: 0600, never readable by others for a moment).

@@ -70,7 +70,13 @@ struct RemoteDesk::Client {
       it = uploads.emplace(submission, FileAssembly(max_bytes)).first;
       upload_order.push_back(submission);
     }
-    if (const std::string why = it->second.add(chunk); !why.empty()) {
+    std::string why;
+    try {
+      why = it->second.add(chunk);
+    } catch (const std::exception& e) {  // no memory for the file: on a DDS thread, nothing may escape
+      why = std::string("the desk could not keep the files: ") + e.what();
+    }
+    if (!why.empty()) {
       upload_errors[submission] = why;
       uploads.erase(it);
       upload_order.erase(std::find(upload_order.begin(), upload_order.end(), submission));
@@ -229,7 +235,13 @@ void RemoteDesk::tend() {
       std::lock_guard<std::mutex> lock(client->mutex);
       requests.swap(client->requests);
     }
-    for (const auto& r : requests) take_order(*client, r);
+    for (const auto& r : requests) {
+      try {
+        take_order(*client, r);
+      } catch (const std::exception& e) {  // a full disk, the database: this order fails, the desk goes on
+        refuse(*client, r.submission().to_string().substr(0, 64), std::string("the desk could not keep the order: ") + e.what(), 1);
+      }
+    }
   }
   const auto orders = store_.orders();
   for (auto it = accepted_.begin(); it != accepted_.end();) {
@@ -241,17 +253,22 @@ void RemoteDesk::tend() {
     }
     Client& client = *clients_.at(it->client);
     std::vector<fs::path> results;
-    for (const auto& entry : fs::directory_iterator(fs::path(known->out))) {
+    std::error_code error;  // no folder: no results
+    for (const auto& entry : fs::directory_iterator(fs::path(known->out), error)) {
       if (entry.is_regular_file()) results.push_back(entry.path());
     }
     const bool done = known->state == "DONE";
     reply(client, it->submission, it->order, done ? cell::DESK_DONE : cell::DESK_FAILED,
           done ? "assembled" : known->reason, done ? 1 : 0, static_cast<unsigned>(results.size()), known->exit_code);
-    for (const auto& file : results) {
-      if (!send_file(*client.results, it->submission, file.filename().string(), read_file_bytes(file))) {
-        log_("desk: the results of " + it->order + " did not all go out to " + client.id + " (its reader fell behind)");
-        break;
+    try {
+      for (const auto& file : results) {
+        if (!send_file(*client.results, it->submission, file.filename().string(), read_file_bytes(file))) {
+          log_("desk: the results of " + it->order + " did not all go out to " + client.id + " (its reader fell behind)");
+          break;
+        }
       }
+    } catch (const std::exception& e) {
+      log_("desk: the results of " + it->order + " did not all go out to " + client.id + ": " + e.what());
     }
     log_("desk: " + it->order + " " + text_of(done ? cell::DESK_DONE : cell::DESK_FAILED) + "; " +
          std::to_string(results.size()) + " result files sent to " + client.id);

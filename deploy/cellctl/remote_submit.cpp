@@ -66,7 +66,11 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
       [&](const cell::FileChunk& c) {
         if (c.submission().to_string() != s.submission) return;
         std::lock_guard<std::mutex> lock(inbox.mutex);
-        if (const std::string why = inbox.results.add(c); !why.empty()) inbox.results_error = why;
+        try {
+          if (const std::string why = inbox.results.add(c); !why.empty()) inbox.results_error = why;
+        } catch (const std::exception& e) {  // on a DDS thread: nothing may escape
+          inbox.results_error = e.what();
+        }
         inbox.changed.notify_all();
       },
       {}, chunk_qos());

@@ -7,19 +7,17 @@
 #include <openssl/pem.h>
 #include <openssl/x509.h>
 
+#include "services/dds/openssl_handles.hpp"
+
 namespace dds {
 
 namespace {
 
 namespace fs = std::filesystem;
 
-template <typename T, void (*Free)(T*)>
-struct Deleter {
-  void operator()(T* p) const { Free(p); }
-};
-using X509Ptr = std::unique_ptr<X509, Deleter<X509, X509_free>>;
-using KeyPtr = std::unique_ptr<EVP_PKEY, Deleter<EVP_PKEY, EVP_PKEY_free>>;
-using BioPtr = std::unique_ptr<BIO, Deleter<BIO, BIO_free_all>>;
+using openssl::BioPtr;
+using openssl::KeyPtr;
+using openssl::X509Ptr;
 
 std::string where(const std::string& identity, const fs::path& file) {
   return "security: identity '" + identity + "' (" + file.string() + ")";
@@ -42,9 +40,7 @@ X509Ptr read_cert(const std::string& identity, const fs::path& file) {
 std::string time_text(const ASN1_TIME* t) {
   BioPtr bio(BIO_new(BIO_s_mem()));
   ASN1_TIME_print(bio.get(), t);
-  char* data = nullptr;
-  const long n = BIO_get_mem_data(bio.get(), &data);
-  return std::string(data, static_cast<std::size_t>(n));
+  return openssl::text_of(bio.get());
 }
 
 // Fast DDS 2.9 takes "file://" followed by the path.

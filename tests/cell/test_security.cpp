@@ -160,18 +160,16 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
 
   {  // A twin's certificate cannot publish a capability; a buffer's cannot publish another
      // buffer's capability (its partition), nor read its commands.
-    const int as_twin = buffer_exit(domain, {"--id", "buffer-7", "--security", pki.string(), "--identity", "twin"}, dir / "twin.log");
-    const std::string twin_log = test::read_text(dir / "twin.log");
-    INFO(twin_log);
-    CHECK(as_twin != 0);
-    CHECK(twin_log.find("cannot create a writer on cell/capabilities: this identity's DDS-Security permissions do not allow it") !=
-          std::string::npos);
-    const int other = buffer_exit(domain, {"--id", "buffer-1", "--security", pki.string(), "--identity", "buffer-2"}, dir / "other.log");
-    const std::string other_log = test::read_text(dir / "other.log");
-    INFO(other_log);
-    CHECK(other != 0);
-    CHECK(other_log.find("cannot create a writer on cell/capabilities: this identity's DDS-Security permissions do not allow it") !=
-          std::string::npos);
+    const auto refused_capability = [&](const std::string& id, const std::string& identity) {
+      const fs::path log = dir / (identity + "-as-" + id + ".log");
+      const int code = buffer_exit(domain, {"--id", id, "--security", pki.string(), "--identity", identity}, log);
+      INFO(test::read_text(log));
+      CHECK(code != 0);
+      CHECK(test::read_text(log).find("cannot create a writer on cell/capabilities: this identity's DDS-Security permissions "
+                                      "do not allow it") != std::string::npos);
+    };
+    refused_capability("buffer-7", "twin");
+    refused_capability("buffer-1", "buffer-2");
     CHECK(trusted_sees.seen().count("buffer-7") == 0);
     auto as_buffer_2 = dds::make_participant("test-buffer-2", {std::stoi(domain), true, {pki, "buffer-2"}});
     CHECK_THROWS_WITH((dds::Reader<cell::Command, cell::CommandPubSubType>(as_buffer_2, dds::command_topic("buffer-1"),
