@@ -216,8 +216,8 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, desk, "max_order_mb", c.desk.max_order_mb);
     read(file, desk, "orders_per_minute", c.desk.orders_per_minute);
     read(file, desk, "max_orders", c.desk.max_orders);
-    if (!(c.desk.max_order_mb > 0) || c.desk.orders_per_minute < 1 || c.desk.max_orders < 1) {
-      throw ConfigError(where(file, desk) + ": max_order_mb must be above 0, orders_per_minute and max_orders 1 or more");
+    if (!(c.desk.max_order_mb > 0 && c.desk.max_order_mb <= 100000) || c.desk.orders_per_minute < 1 || c.desk.max_orders < 1) {
+      throw ConfigError(where(file, desk) + ": max_order_mb must be above 0 and at most 100000, orders_per_minute and max_orders 1 or more");
     }
   }
   if (root["security"]) {
@@ -253,6 +253,14 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   std::set<std::string> ids;
   for (const auto& [id, node] : named) {
     if (!ids.insert(id).second) throw ConfigError(where(file, node) + ": a second resource is called '" + id + "'");
+  }
+  // A client's id names its DDS-Security identity too: none may be another's.
+  ids.insert({"cell-sim", "twin", "cellctl", "order-desk"});
+  for (const auto& id : c.clients) {
+    if (!ids.insert(id).second) {
+      throw ConfigError(where(file, root["clients"]) + ": the client '" + id + "' has the name of a resource, of another client or of " +
+                        "cell-sim, twin, cellctl or order-desk");
+    }
   }
   for (std::size_t i = 0; i < c.stations.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {

@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <openssl/evp.h>
 
@@ -34,7 +35,8 @@ std::string bad_file_name(const std::string& name) {
   return "";
 }
 
-bool send_file(ChunkWriter& writer, const std::string& submission, const std::string& name, const std::string& bytes) {
+bool send_file(ChunkWriter& writer, const std::string& submission, const std::string& name, const std::string& bytes,
+               std::chrono::steady_clock::time_point deadline) {
   cell::FileChunk chunk;
   chunk.submission(submission);
   chunk.name(name);
@@ -45,7 +47,10 @@ bool send_file(ChunkWriter& writer, const std::string& submission, const std::st
     chunk.offset(offset);
     chunk.data().assign(bytes.begin() + static_cast<std::ptrdiff_t>(offset),
                         bytes.begin() + static_cast<std::ptrdiff_t>(offset + n));
-    if (!writer.write(chunk)) return false;
+    while (!writer.write(chunk)) {  // 64 chunks wait for a reader already: it takes them at its pace
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     offset += n;
   } while (offset < bytes.size());
   return true;

@@ -3,6 +3,7 @@
 // remote client: the product's files to the desk, the results back. Every chunk is checked
 // before it takes memory: a safe relative name, an offset and size that fit, a total bound.
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -32,8 +33,10 @@ std::string sha256_hex(const std::string& bytes);
 // Why `name` may not name a file of an order (absolute, "..", empty, too long); "" when it may.
 std::string bad_file_name(const std::string& name);
 
-// Writes `bytes` as chunks of `submission`'s file `name`; false when a write failed.
-bool send_file(ChunkWriter& writer, const std::string& submission, const std::string& name, const std::string& bytes);
+// Writes `bytes` as chunks of `submission`'s file `name`. A chunk the readers have no room for
+// yet is written again until `deadline`; false when it passed.
+bool send_file(ChunkWriter& writer, const std::string& submission, const std::string& name, const std::string& bytes,
+               std::chrono::steady_clock::time_point deadline);
 
 std::string read_file_bytes(const std::filesystem::path& file);
 

@@ -88,8 +88,9 @@ void add_extension(X509* cert, X509* issuer, int nid, const char* value) {
   X509V3_set_ctx_nodb(&ctx);
   X509V3_set_ctx(&ctx, issuer, cert, nullptr, nullptr, 0);
   X509_EXTENSION* ext = X509V3_EXT_conf_nid(nullptr, &ctx, nid, value);
-  if (!ext || !X509_add_ext(cert, ext, -1)) fail(std::string("cannot add the extension ") + value);
+  const bool added = ext && X509_add_ext(cert, ext, -1);
   X509_EXTENSION_free(ext);
+  if (!added) fail(std::string("cannot add the extension ") + value);
 }
 
 // Signed by `issuer_key`; self-signed when `issuer` is null.
@@ -101,17 +102,18 @@ X509Ptr make_cert(const std::string& common_name, EVP_PKEY* key, X509* issuer, E
       !BN_to_ASN1_INTEGER(serial.get(), X509_get_serialNumber(cert.get()))) {
     fail("cannot make a certificate");
   }
-  X509_set_version(cert.get(), 2);
+  if (!X509_set_version(cert.get(), 2)) fail("cannot make a certificate");
   std::time_t from = std::chrono::system_clock::to_time_t(validity.not_before);
   if (!X509_time_adj_ex(X509_getm_notBefore(cert.get()), 0, 0, &from) ||
       !X509_time_adj_ex(X509_getm_notAfter(cert.get()), validity.days, 0, &from)) {
     fail("cannot set the validity");
   }
   X509_NAME* name = X509_get_subject_name(cert.get());
-  X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_UTF8, reinterpret_cast<const unsigned char*>(common_name.c_str()), -1,
-                             -1, 0);
-  X509_set_issuer_name(cert.get(), issuer ? X509_get_subject_name(issuer) : name);
-  X509_set_pubkey(cert.get(), key);
+  if (!X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_UTF8, reinterpret_cast<const unsigned char*>(common_name.c_str()), -1,
+                                  -1, 0) ||
+      !X509_set_issuer_name(cert.get(), issuer ? X509_get_subject_name(issuer) : name) || !X509_set_pubkey(cert.get(), key)) {
+    fail("cannot make the certificate of " + common_name);
+  }
   X509* signer = issuer ? issuer : cert.get();
   add_extension(cert.get(), signer, NID_basic_constraints, issuer ? "critical,CA:FALSE" : "critical,CA:TRUE");
   add_extension(cert.get(), signer, NID_key_usage, issuer ? "critical,digitalSignature,keyAgreement" : "critical,keyCertSign,cRLSign,digitalSignature");
@@ -124,8 +126,8 @@ X509Ptr make_cert(const std::string& common_name, EVP_PKEY* key, X509* issuer, E
 
 void make_ca(const fs::path& dir, const std::string& name, const Validity& validity) {
   const fs::path key_file = dir / "ca.key.pem";
-  if (fs::exists(key_file)) {
-    throw PkiError("pki: " + key_file.string() + " exists: a cell keeps its CA (`cellctl pki issue` adds identities)");
+  for (const fs::path& f : {key_file, dir / "ca.cert.pem"}) {
+    if (fs::exists(f)) throw PkiError("pki: " + f.string() + " exists: a cell keeps its CA (`cellctl pki issue` adds identities)");
   }
   fs::create_directories(dir);
   fs::permissions(dir, fs::perms::owner_all);

@@ -50,7 +50,7 @@ struct RemoteDesk::Client {
   std::map<std::string, std::string> upload_errors;  // submission -> why its files were refused
   std::deque<std::string> upload_order;              // oldest first
   std::deque<cell::OrderRequest> requests;
-  std::deque<std::chrono::steady_clock::time_point> accepted_at;  // the last minute's
+  std::deque<std::chrono::steady_clock::time_point> requested_at;  // the last minute's orders
   std::unique_ptr<dds::Reader<cell::FileChunk, cell::FileChunkPubSubType>> files;
   std::unique_ptr<dds::Reader<cell::OrderRequest, cell::OrderRequestPubSubType>> orders;
   std::unique_ptr<dds::Writer<cell::DeskReply, cell::DeskReplyPubSubType>> replies;
@@ -77,6 +77,7 @@ struct RemoteDesk::Client {
       why = std::string("the desk could not keep the files: ") + e.what();
     }
     if (!why.empty()) {
+      if (upload_errors.size() >= kUploadsPerClient) upload_errors.erase(upload_errors.begin());
       upload_errors[submission] = why;
       uploads.erase(it);
       upload_order.erase(std::find(upload_order.begin(), upload_order.end(), submission));
@@ -113,16 +114,18 @@ RemoteDesk::RemoteDesk(const CellConfig& cell, state::CellStore& store, CellObse
     const fs::path folder = out.parent_path();
     if (known.ended() || out.filename() != "out" || folder.parent_path().parent_path() != cell.state_folder() / "desk") continue;
     const std::string client = folder.parent_path().filename(), submission = folder.filename();
-    if (clients_.count(client)) accepted_.push_back({client, submission, known.order, ""});
+    if (clients_.count(client)) accepted_.push_back({client, submission, "", known.order, ""});
   }
 }
 
 RemoteDesk::~RemoteDesk() = default;
 
-void RemoteDesk::reply(Client& client, const std::string& submission, const std::string& order, cell::DeskState state,
-                       const std::string& message, double progress, unsigned result_files, int exit_code) {
+void RemoteDesk::reply(Client& client, const std::string& submission, const std::string& request, const std::string& order,
+                       cell::DeskState state, const std::string& message, double progress, unsigned result_files,
+                       int exit_code) {
   cell::DeskReply r;
   r.submission(submission);
+  r.request(request.substr(0, 255));
   r.order_id(order);
   r.state(state);
   r.message(message.substr(0, 1000));
@@ -130,26 +133,42 @@ void RemoteDesk::reply(Client& client, const std::string& submission, const std:
   r.result_files(result_files);
   r.exit_code(exit_code);
   client.replies->write(r);
+  if (state == cell::DESK_REFUSED || state == cell::DESK_DONE || state == cell::DESK_FAILED) {
+    answered_.push_back({&client, r, std::chrono::steady_clock::now()});
+  }
 }
 
-void RemoteDesk::refuse(Client& client, const std::string& submission, const std::string& why, int exit_code) {
+void RemoteDesk::refuse(Client& client, const cell::OrderRequest& request, const std::string& why, int exit_code) {
+  const std::string submission = request.submission().to_string().substr(0, 64);
   log_("desk: refused " + client.id + "'s order " + submission + ": " + why);
-  store_.journal("desk", "refused", client.id + "/" + submission, why);
-  reply(client, submission, "", cell::DESK_REFUSED, why, 0, 0, exit_code);
+  reply(client, submission, request.request().to_string(), "", cell::DESK_REFUSED, why, 0, 0, exit_code);
 }
 
 void RemoteDesk::take_order(Client& client, const cell::OrderRequest& request) {
   const std::string submission = request.submission().to_string();
-  if (!good_submission(submission)) {
-    return refuse(client, submission.substr(0, 64), "a submission id is 1 to 64 of A-Z, a-z, 0-9, ., _ and -", 2);
+  // Every request counts, refused or not, and is counted first: a client that sends more
+  // costs the cell a refusal each, and past 4 times its rate not even that.
+  const auto now = std::chrono::steady_clock::now();
+  while (!client.requested_at.empty() && now - client.requested_at.front() > std::chrono::minutes(1)) client.requested_at.pop_front();
+  const auto in_last_minute = static_cast<int>(client.requested_at.size());
+  if (in_last_minute >= 4 * cell_.desk.orders_per_minute) {
+    if (in_last_minute == 4 * cell_.desk.orders_per_minute) log_("desk: " + client.id + " floods the desk; its orders are dropped for a minute");
+    client.requested_at.push_back(now);
+    return;
   }
+  client.requested_at.push_back(now);
+  if (in_last_minute >= cell_.desk.orders_per_minute) {
+    return refuse(client, request, "the desk takes " + std::to_string(cell_.desk.orders_per_minute) +
+                                       " orders a minute from a client; try again in a minute", 1);
+  }
+  if (!good_submission(submission)) return refuse(client, request, "a submission id is 1 to 64 of A-Z, a-z, 0-9, ., _ and -", 2);
   std::optional<FileAssembly> upload;
   {
     std::lock_guard<std::mutex> lock(client.mutex);
     if (const auto e = client.upload_errors.find(submission); e != client.upload_errors.end()) {
       const std::string why = e->second;
       client.upload_errors.erase(e);
-      return refuse(client, submission, why, 2);
+      return refuse(client, request, why, 2);
     }
     if (const auto u = client.uploads.find(submission); u != client.uploads.end()) {
       upload = std::move(u->second);
@@ -158,62 +177,70 @@ void RemoteDesk::take_order(Client& client, const cell::OrderRequest& request) {
     }
   }
   const std::string order = client.id + "-" + submission;
-  const auto now = std::chrono::steady_clock::now();
-  while (!client.accepted_at.empty() && now - client.accepted_at.front() > std::chrono::minutes(1)) client.accepted_at.pop_front();
-  if (static_cast<int>(client.accepted_at.size()) >= cell_.desk.orders_per_minute) {
-    return refuse(client, submission, "the desk takes " + std::to_string(cell_.desk.orders_per_minute) +
-                                          " orders a minute from a client; try again in a minute", 1);
-  }
   const auto orders = store_.orders();
   const auto under_way = std::count_if(orders.begin(), orders.end(), [](const auto& o) { return !o.ended(); });
   if (under_way >= cell_.desk.max_orders) {
-    return refuse(client, submission, "the cell has " + std::to_string(under_way) + " orders under way, its limit; try again later", 1);
+    return refuse(client, request, "the cell has " + std::to_string(under_way) + " orders under way, its limit; try again later", 1);
   }
   if (std::any_of(orders.begin(), orders.end(), [&](const auto& o) { return o.order == order; })) {
-    return refuse(client, submission, "the cell has an order " + order + " already: give this one another submission id", 2);
+    return refuse(client, request, "the cell has an order " + order + " already: give this one another submission id", 2);
   }
-  if (!upload) return refuse(client, submission, "no file of this submission came", 2);
+  if (!upload) return refuse(client, request, "no file of this submission came", 2);
   const std::string product = request.product().to_string();
   bool has_product = false;
   for (const auto& f : request.files()) {
     const std::string name = f.name().to_string();
     const std::string* bytes = upload->complete(name);
-    if (!bytes) return refuse(client, submission, name + ": its chunks did not all come", 2);
+    if (!bytes) return refuse(client, request, name + ": its chunks did not all come", 2);
     if (bytes->size() != f.size() || sha256_hex(*bytes) != f.sha256().to_string()) {
-      return refuse(client, submission, name + ": its size or SHA-256 is not what the order says", 2);
+      return refuse(client, request, name + ": its size or SHA-256 is not what the order says", 2);
     }
     has_product |= name == product;
   }
-  if (!has_product) return refuse(client, submission, "the product " + product + " is not among the order's files", 2);
+  if (!has_product) return refuse(client, request, "the product " + product + " is not among the order's files", 2);
+  const std::string sequence = request.sequence_strategy().to_string().empty() ? "search" : request.sequence_strategy().to_string();
+  if (sequence != "search" && sequence != "paper") {
+    return refuse(client, request, "sequence_strategy: '" + sequence + "' is none of search, paper", 2);
+  }
+  store_order(client, request, *upload);
+}
 
+// Writes the files, reads the description, hands the order to the local desk; a refusal, or
+// an error, leaves nothing behind.
+void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, const FileAssembly& upload) {
+  const std::string submission = request.submission().to_string(), product = request.product().to_string();
+  const std::string order = client.id + "-" + submission;
   const fs::path folder = cell_.state_folder() / "desk" / client.id / submission;
   std::error_code ignored;
   fs::remove_all(folder, ignored);
-  for (const auto& f : request.files()) {
-    const fs::path file = folder / "product" / f.name().to_string();
-    fs::create_directories(file.parent_path());
-    std::ofstream(file, std::ios::binary) << *upload->complete(f.name().to_string());
-  }
   try {
-    twin::build_product(twin::AutomationMLDescription(folder / "product" / product));
-  } catch (const twin::DescriptionError& e) {
+    for (const auto& f : request.files()) {
+      const fs::path file = folder / "product" / f.name().to_string();
+      fs::create_directories(file.parent_path());
+      std::ofstream out(file, std::ios::binary);
+      out << *upload.complete(f.name().to_string());
+      if (!out.flush()) throw std::runtime_error("cannot write " + file.string());
+    }
+    try {
+      twin::build_product(twin::AutomationMLDescription(folder / "product" / product));
+    } catch (const twin::DescriptionError& e) {
+      fs::remove_all(folder, ignored);
+      return refuse(client, request, relative_to(e.what(), folder / "product"), 2);
+    }
+    fs::create_directories(folder / "out");
+    const std::string sequence = request.sequence_strategy().to_string().empty() ? "search" : request.sequence_strategy().to_string();
+    if (!store_.submit_order({order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"})) {
+      fs::remove_all(folder, ignored);
+      return refuse(client, request, "the cell has an order " + order + " already", 2);
+    }
+  } catch (...) {
     fs::remove_all(folder, ignored);
-    return refuse(client, submission, relative_to(e.what(), folder / "product"), 2);
+    throw;
   }
-  const std::string sequence = request.sequence_strategy().to_string().empty() ? "search" : request.sequence_strategy().to_string();
-  if (sequence != "search" && sequence != "paper") {
-    fs::remove_all(folder, ignored);
-    return refuse(client, submission, "sequence_strategy: '" + sequence + "' is none of search, paper", 2);
-  }
-  fs::create_directories(folder / "out");
-  if (!store_.submit_order({order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"})) {
-    return refuse(client, submission, "the cell has an order " + order + " already", 2);
-  }
-  client.accepted_at.push_back(now);
-  store_.journal("desk", "submitted", order, client.id + ": " + product + ", " + std::to_string(upload->bytes()) + " bytes");
+  store_.journal("desk", "submitted", order, client.id + ": " + product + ", " + std::to_string(upload.bytes()) + " bytes");
   log_("desk: " + client.id + "'s order " + submission + " accepted as " + order);
-  reply(client, submission, order, cell::DESK_ACCEPTED, "order " + order + " accepted");
-  accepted_.push_back({client.id, submission, order, ""});
+  reply(client, submission, request.request().to_string(), order, cell::DESK_ACCEPTED, "order " + order + " accepted");
+  accepted_.push_back({client.id, submission, request.request().to_string(), order, ""});
 }
 
 void RemoteDesk::follow(Accepted& a) {
@@ -223,12 +250,35 @@ void RemoteDesk::follow(Accepted& a) {
     const std::string now = std::to_string(static_cast<int>(s->second.state())) + "|" + s->second.message().to_string();
     if (now != a.last_state) {
       a.last_state = now;
-      reply(client, a.submission, a.order, cell::DESK_PROGRESS, s->second.message().to_string(), s->second.progress());
+      reply(client, a.submission, a.request, a.order, cell::DESK_PROGRESS, s->second.message().to_string(), s->second.progress());
     }
   }
 }
 
+void RemoteDesk::finish(Accepted& a, const state::OrderRecord& record) {
+  Client& client = *clients_.at(a.client);
+  std::vector<fs::path> results;
+  std::error_code error;  // no folder: no results
+  for (fs::directory_iterator it(fs::path(record.out), error), end; !error && it != end; it.increment(error)) {
+    if (it->is_regular_file(error)) results.push_back(it->path());
+  }
+  const bool done = record.state == "DONE";
+  reply(client, a.submission, a.request, a.order, done ? cell::DESK_DONE : cell::DESK_FAILED, done ? "assembled" : record.reason,
+        done ? 1 : 0, static_cast<unsigned>(results.size()), record.exit_code);
+  // A client that stopped reading holds the desk up to 10 s, once.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  for (const auto& file : results) {
+    if (!send_file(*client.results, a.submission, file.filename().string(), read_file_bytes(file), deadline)) {
+      log_("desk: the results of " + a.order + " did not all go out to " + client.id + " (its reader fell behind)");
+      return;
+    }
+  }
+  log_("desk: " + a.order + " " + text_of(done ? cell::DESK_DONE : cell::DESK_FAILED) + "; " + std::to_string(results.size()) +
+       " result files sent to " + client.id);
+}
+
 void RemoteDesk::tend() {
+  // Nothing of one client's order may end cellctl up: a full disk, the database, a file.
   for (auto& [id, client] : clients_) {
     std::deque<cell::OrderRequest> requests;
     {
@@ -238,41 +288,35 @@ void RemoteDesk::tend() {
     for (const auto& r : requests) {
       try {
         take_order(*client, r);
-      } catch (const std::exception& e) {  // a full disk, the database: this order fails, the desk goes on
-        refuse(*client, r.submission().to_string().substr(0, 64), std::string("the desk could not keep the order: ") + e.what(), 1);
+      } catch (const std::exception& e) {
+        refuse(*client, r, std::string("the desk could not keep the order: ") + e.what(), 1);
       }
     }
   }
-  const auto orders = store_.orders();
-  for (auto it = accepted_.begin(); it != accepted_.end();) {
-    follow(*it);
-    const auto known = std::find_if(orders.begin(), orders.end(), [&](const auto& o) { return o.order == it->order; });
-    if (known == orders.end() || !known->ended() || known->exit_code < 0) {
-      ++it;
-      continue;
-    }
-    Client& client = *clients_.at(it->client);
-    std::vector<fs::path> results;
-    std::error_code error;  // no folder: no results
-    for (const auto& entry : fs::directory_iterator(fs::path(known->out), error)) {
-      if (entry.is_regular_file()) results.push_back(entry.path());
-    }
-    const bool done = known->state == "DONE";
-    reply(client, it->submission, it->order, done ? cell::DESK_DONE : cell::DESK_FAILED,
-          done ? "assembled" : known->reason, done ? 1 : 0, static_cast<unsigned>(results.size()), known->exit_code);
-    try {
-      for (const auto& file : results) {
-        if (!send_file(*client.results, it->submission, file.filename().string(), read_file_bytes(file))) {
-          log_("desk: the results of " + it->order + " did not all go out to " + client.id + " (its reader fell behind)");
-          break;
-        }
+  try {
+    const auto orders = store_.orders();
+    for (auto it = accepted_.begin(); it != accepted_.end();) {
+      follow(*it);
+      const auto known = std::find_if(orders.begin(), orders.end(), [&](const auto& o) { return o.order == it->order; });
+      if (known == orders.end() || !known->ended() || known->exit_code < 0) {
+        ++it;
+        continue;
       }
-    } catch (const std::exception& e) {
-      log_("desk: the results of " + it->order + " did not all go out to " + client.id + ": " + e.what());
+      try {
+        finish(*it, *known);
+      } catch (const std::exception& e) {
+        log_("desk: the results of " + it->order + " did not all go out: " + e.what());
+      }
+      it = accepted_.erase(it);
     }
-    log_("desk: " + it->order + " " + text_of(done ? cell::DESK_DONE : cell::DESK_FAILED) + "; " +
-         std::to_string(results.size()) + " result files sent to " + client.id);
-    it = accepted_.erase(it);
+  } catch (const std::exception& e) {
+    log_(std::string("desk: cannot follow the orders now: ") + e.what());
+  }
+  // A final reply stays for a client that joins late for a minute, then its instance goes:
+  // the replies writer keeps no instance per submission for ever.
+  while (!answered_.empty() && std::chrono::steady_clock::now() - answered_.front().at > std::chrono::minutes(1)) {
+    answered_.front().client->replies->unregister(answered_.front().reply);
+    answered_.pop_front();
   }
 }
 

@@ -36,15 +36,23 @@ class RemoteDesk {
  private:
   struct Client;
   struct Accepted {  // an order of a client, until its results are sent
-    std::string client, submission, order;
+    std::string client, submission, request, order;
     std::string last_state;
+  };
+  struct Answered {  // a final reply, kept for a late reader a while, then unregistered
+    Client* client;
+    cell::DeskReply reply;
+    std::chrono::steady_clock::time_point at;
   };
 
   void take_order(Client& client, const cell::OrderRequest& request);
-  void refuse(Client& client, const std::string& submission, const std::string& why, int exit_code);
-  void reply(Client& client, const std::string& submission, const std::string& order, cell::DeskState state,
-             const std::string& message, double progress = 0, unsigned result_files = 0, int exit_code = 0);
+  void store_order(Client& client, const cell::OrderRequest& request, const FileAssembly& upload);
+  void refuse(Client& client, const cell::OrderRequest& request, const std::string& why, int exit_code);
+  void reply(Client& client, const std::string& submission, const std::string& request, const std::string& order,
+             cell::DeskState state, const std::string& message, double progress = 0, unsigned result_files = 0,
+             int exit_code = 0);
   void follow(Accepted& order);  // relays its progress
+  void finish(Accepted& order, const state::OrderRecord& record);  // the last reply and the results
 
   const CellConfig& cell_;
   state::CellStore& store_;
@@ -52,6 +60,7 @@ class RemoteDesk {
   std::function<void(const std::string&)> log_;
   std::map<std::string, std::unique_ptr<Client>> clients_;
   std::vector<Accepted> accepted_;
+  std::deque<Answered> answered_;
 };
 
 }  // namespace cellctl

@@ -37,9 +37,17 @@ namespace fdds = eprosima::fastdds::dds;
 // in its reader) another resource's commands.
 inline std::string command_topic(const std::string& resource_id) { return "cell/commands/" + resource_id; }
 
+// Whether the participant has DDS-Security access control (services/dds/security.hpp).
+inline bool access_controlled(const fdds::DomainParticipant& participant) {
+  for (const auto& p : participant.get_qos().properties().properties()) {
+    if (p.name() == "dds.sec.access.plugin") return true;
+  }
+  return false;
+}
+
 // Topics every resource writes about itself (its capability, its commands' events). Each
 // writes them in a DDS partition named after its id, and their readers read every partition
-// (the default one too: a process or a test that writes with none is still heard):
+// (every_partition()):
 // DDS-Security permissions then let a resource write its own and no other's
 // (deploy/cellctl/pki_policy.cpp).
 inline bool owned_topic(const std::string& topic) { return topic == "cell/capabilities" || topic == "cell/command_events"; }
@@ -48,6 +56,15 @@ inline bool owned_topic(const std::string& topic) { return topic == "cell/capabi
 inline QosSettings owned_by(std::vector<std::string> owner, QosSettings settings = {}) {
   settings.partitions = std::move(owner);
   return settings;
+}
+
+// A reader of an owned topic: every resource's partition; and the default one ("*" matches no
+// writer there) unless access control is on: DDS-Security checks a writer's partition and
+// topic each against all of a grant's rules, so a resource's grant, which has the default
+// partition for its other topics, would let it write a capability there.
+inline std::vector<std::string> every_partition(const fdds::DomainParticipant& participant) {
+  if (access_controlled(participant)) return {"*"};
+  return {"*", ""};
 }
 
 template <class Qos>
@@ -59,10 +76,7 @@ Qos with_partitions(Qos qos, const std::vector<std::string>& partitions) {
 // Why Fast DDS refused an endpoint, as far as we know: under DDS-Security, the identity's
 // permissions (Fast DDS logs which rule), else nothing more to say.
 inline std::string refusal_reason(const fdds::DomainParticipant& participant) {
-  for (const auto& p : participant.get_qos().properties().properties()) {
-    if (p.name() == "dds.sec.access.plugin") return ": this identity's DDS-Security permissions do not allow it";
-  }
-  return "";
+  return access_controlled(participant) ? ": this identity's DDS-Security permissions do not allow it" : "";
 }
 
 // The topic of that name on the participant, created (and its type registered) if needed.
@@ -99,6 +113,15 @@ class Writer : private fdds::DataWriterListener {
   Writer& operator=(const Writer&) = delete;
 
   bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
+
+  // Keyed topics: the instance of `sample` ends here (late readers no longer get it).
+  void unregister(const T& sample) { writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL); }
+
+  // Until every matched reader acknowledged every sample written (at most `timeout`).
+  bool wait_for_acknowledgments(std::chrono::milliseconds timeout) {
+    return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(static_cast<double>(timeout.count()) / 1000)) ==
+           ReturnCode_t::RETCODE_OK;
+  }
 
   // Waits until at least `readers` readers have matched; never sleep a guessed time.
   bool wait_for_readers(int readers, std::chrono::milliseconds timeout) {
@@ -196,9 +219,9 @@ class Reader : private fdds::DataReaderListener {
   Reader(ParticipantPtr participant, const std::string& topic, TopicKind kind, std::function<void(const T&)> on_sample,
          std::function<void(const T&)> on_gone = {}, const QosSettings& settings = {})
       : participant_(std::move(participant)), kind_(kind), on_sample_(std::move(on_sample)), on_gone_(std::move(on_gone)) {
-    const std::vector<std::string> every{"*", ""};  // "*" matches no writer of the default partition
-    subscriber_ = participant_->create_subscriber(
-        with_partitions(fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && owned_topic(topic) ? every : settings.partitions));
+    subscriber_ = participant_->create_subscriber(with_partitions(
+        fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && owned_topic(topic) ? every_partition(*participant_)
+                                                                                        : settings.partitions));
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
   }

@@ -90,6 +90,9 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   qos.name(name);
   // The addresses to use and to look for others at: loopback, or the deployment's network.
   std::vector<std::string> interfaces, peers;
+  if (settings.interfaces.empty() && !settings.peers.empty()) {
+    throw std::runtime_error("DDS participant '" + name + "': peers (--peer) need the host's own addresses (--interface)");
+  }
   if (settings.localhost_only) {
     interfaces = peers = {"127.0.0.1"};
   } else if (!settings.interfaces.empty()) {

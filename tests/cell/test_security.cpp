@@ -223,6 +223,7 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   std::string yaml = test::read_text(DEFAULT_CELL);
   yaml.replace(yaml.find("max_order_mb: 64"), 16, "max_order_mb: 0.05");
   yaml.replace(yaml.find("orders_per_minute: 6"), 20, "orders_per_minute: 1");
+  yaml.replace(yaml.find("clients: [oem-a, oem-b]"), 23, "clients: [oem-a, oem-b, oem-c]");
   const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
   std::ofstream(cell) << yaml;
   REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
@@ -230,13 +231,26 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
                          "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
                         (dir / "up.log").string());
   REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+  const auto args = [&](const std::string& client, const std::string& product, const std::string& id) {
+    return std::vector<std::string>{CELLCTL_EXE, "submit", "--remote", "--client", client, product, "--cell", cell.string(),
+                                    "--domain", domain, "--security", pki.string(), "--order", id, "--out", (dir / id).string()};
+  };
   const auto submit = [&](const std::string& client, const std::string& product, const std::string& id) {
-    return test::cellctl({"submit", "--remote", "--client", client, product, "--cell", cell.string(), "--domain", domain,
-                          "--security", pki.string(), "--order", id, "--out", (dir / id).string()},
-                         dir / (id + ".log"));
+    test::ChildProcess p(args(client, product, id), (dir / (id + ".log")).string());
+    return p.wait_for_exit(120s);
+  };
+  const auto refused = [&](const std::string& id, int code, const std::string& why) {
+    const std::string log = test::read_text(dir / (id + ".log"));
+    INFO(log);
+    CHECK(log.find("the desk refused the order: " + why) != std::string::npos);
+    return code;
   };
 
-  const int lego = submit("oem-a", kLego, "tower");
+  // While oem-a's first order runs, its second within the minute is refused.
+  test::ChildProcess tower(args("oem-a", kLego, "tower"), (dir / "tower.log").string());
+  REQUIRE(test::appears(dir / "tower.log", "order oem-a-tower accepted", 60s));
+  CHECK(refused("again", submit("oem-a", kLego, "again"), "the desk takes 1 orders a minute from a client") == 1);
+  const int lego = tower.wait_for_exit(120s);
   {
     INFO(test::read_text(dir / "tower.log") << test::read_text(dir / "up.log"));
     REQUIRE(lego == 0);
@@ -245,16 +259,10 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   CHECK(fs::file_size(dir / "tower" / "animation.gltf") > 1000);
   CHECK(fs::exists(dir / "state" / "desk" / "oem-a" / "tower" / "product" / "lego-tower.aml"));
 
-  const auto refused = [&](const std::string& id, int code, const std::string& why) {
-    const std::string log = test::read_text(dir / (id + ".log"));
-    INFO(log);
-    CHECK(log.find("the desk refused the order: " + why) != std::string::npos);
-    return code;
-  };
-  CHECK(refused("big", submit("oem-b", std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "big"), "the order's files pass the desk's limit of 50000 bytes") == 2);
-  CHECK(refused("bad", submit("oem-b", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "bad"), "unknown_link_id.aml:") == 2);
-  CHECK(refused("again", submit("oem-a", kLego, "again"), "the desk takes 1 orders a minute from a client") == 1);
-  CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-b" / "bad"));  // nothing kept of a refused order
+  CHECK(refused("big", submit("oem-b", std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "big"),
+                "the order's files pass the desk's limit of 50000 bytes") == 2);
+  CHECK(refused("bad", submit("oem-c", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "bad"), "unknown_link_id.aml:") == 2);
+  CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-c" / "bad"));  // nothing kept of a refused order
 
   // oem-b's certificate reads its own answers, not oem-a's, nor the cell's order status.
   auto oem_b = dds::make_participant("test-oem-b", {std::stoi(domain), true, {pki, "oem-b"}});
@@ -268,4 +276,5 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
   CHECK(test::read_text(dir / "up.log").find("refused oem-b's order big") != std::string::npos);
+  CHECK(test::read_text(dir / "up.log").find("refused oem-a's order again") != std::string::npos);
 }
