@@ -329,13 +329,14 @@ class TwinProcess {
         r.post("negotiator", "TICK");
       }
     }
-    if (!finished) return end_with(1, "stopped before the order ended");
+    services::ExitWatchdog watchdog(std::chrono::seconds(30));  // ends us if the DDS entities' teardown hangs
+    if (!finished) return watchdog.exit(end_with(1, "stopped before the order ended"));
     if (orchestrator.take_up()) {
       // Nothing released, no final status: the cell's next twin takes the order up.
       store_->set_order(options_.order, "INTERRUPTED", orchestrator.error());
       store_->journal("twin-" + options_.order, "to be taken up", options_.order, orchestrator.error());
       std::cerr << "order " << options_.order << ": " << orchestrator.error() << "; the next twin takes it up\n";
-      return 3;
+      return watchdog.exit(3);
     }
 
     // What the designer gets: the plan as virtual assembly validated it (replanned if cell-sim
@@ -347,11 +348,11 @@ class TwinProcess {
     twin::AnimationOptions look;
     look.gripper = options_.gripper;
     twin::write_gltf_animation(product, validated, animation, look);
-    if (!orchestrator.error().empty()) return end_with(1, orchestrator.error(), plan_file.string(), true);
+    if (!orchestrator.error().empty()) return watchdog.exit(end_with(1, orchestrator.error(), plan_file.string(), true));
     result(true, plan_file.string(), animation.string(), "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);
     linger();
-    return 0;
+    return watchdog.exit(0);
   }
 
   Options options_;
