@@ -93,6 +93,39 @@ void add_pki_command(CLI::App& app, int& exit_code) {
     std::cerr << "error: " << o->name << " is no identity of the cell " << cell.file.string() << " (it has " << known << ")\n";
     exit_code = 2;
   });
+
+  // What an OEM (or another host) gets: the CA's certificate, the governance and one identity,
+  // never the CA's key nor other identities.
+  auto out = std::make_shared<std::string>();
+  CLI::App* export_cmd = pki_cmd->add_subcommand(
+      "export", "Copy what one identity needs (the CA's certificate, the governance, its folder) to OUT, for another host");
+  export_cmd->add_option("DIR", o->dir, "The cell's security folder")->required()->check(CLI::ExistingDirectory);
+  export_cmd->add_option("NAME", o->name, "The identity, e.g. a client of `clients:`")->required();
+  export_cmd->add_option("OUT", *out, "A new folder, to be passed as --security on the other host")->required();
+  export_cmd->callback([o, out, &exit_code] {
+    const fs::path dir = o->dir, to = *out;
+    const dds::IdentityFiles from = dds::identity_files(dir, o->name);
+    if (!fs::exists(from.cert)) {
+      std::cerr << "error: " << from.cert.string() << " does not exist: `cellctl pki issue` makes the identity first\n";
+      exit_code = 2;
+      return;
+    }
+    if (fs::exists(to)) {
+      std::cerr << "error: " << to.string() << " exists: export into a new folder\n";
+      exit_code = 2;
+      return;
+    }
+    const dds::IdentityFiles copy = dds::identity_files(to, o->name);
+    fs::create_directories(copy.cert.parent_path());
+    for (const fs::path& d : {to, to / "identities", copy.cert.parent_path()}) fs::permissions(d, fs::perms::owner_all);
+    fs::copy_file(from.ca_cert, copy.ca_cert);
+    fs::copy_file(from.governance, copy.governance);
+    fs::copy(from.cert.parent_path(), copy.cert.parent_path(), fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+    fs::permissions(copy.key, fs::perms::owner_read | fs::perms::owner_write);
+    std::cout << "identity " << o->name << " exported to " << to.string() << " (its key " << copy.key.string()
+              << ", mode 0600): pass it as --security there\n";
+    exit_code = 0;
+  });
 }
 
 }  // namespace cellctl

@@ -119,6 +119,14 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
   CHECK(test::cellctl({"pki", "init", pki.string(), "--domain", "224"}, dir / "again.log") == 1);
   CHECK(test::read_text(dir / "again.log").find("ca.key.pem exists") != std::string::npos);
   CHECK(test::read_text(pki / "ca.key.pem") == ca_key);
+  // What another host gets: the CA's certificate, the governance and one identity, its key 0600.
+  REQUIRE(test::cellctl({"pki", "export", pki.string(), "buffer-1", (dir / "for-buffer-1").string()}, dir / "export.log") == 0);
+  CHECK(fs::exists(dir / "for-buffer-1" / "ca.cert.pem"));
+  CHECK(fs::exists(dir / "for-buffer-1" / "governance.p7s"));
+  CHECK(mode_of(dir / "for-buffer-1" / "identities" / "buffer-1" / "key.pem") == 0600);
+  CHECK_FALSE(fs::exists(dir / "for-buffer-1" / "ca.key.pem"));
+  CHECK_FALSE(fs::exists(dir / "for-buffer-1" / "identities" / "buffer-2"));
+  CHECK(test::cellctl({"pki", "export", pki.string(), "buffer-1", (dir / "for-buffer-1").string()}, dir / "export2.log") == 2);
   // An identity the cell does not have is not issued.
   CHECK(test::cellctl({"pki", "issue", pki.string(), "buffer-9", "--domain", "224"}, dir / "issue.log") == 2);
   CHECK(test::read_text(dir / "issue.log").find("buffer-9 is no identity of the cell") != std::string::npos);

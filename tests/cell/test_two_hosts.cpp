@@ -84,10 +84,9 @@ TEST_CASE("two hosts: an OEM in one network namespace submits Cranfield to a sec
   }
   // The OEM has its own folder: the CA's certificate, the governance and its identity only.
   const fs::path oem = dir / "oem-a";
-  fs::create_directories(oem / "identities");
-  fs::copy(pki / "ca.cert.pem", oem);
-  fs::copy(pki / "governance.p7s", oem);
-  fs::copy(pki / "identities" / "oem-a", oem / "identities" / "oem-a", fs::copy_options::recursive);
+  REQUIRE(test::cellctl({"pki", "export", pki.string(), "oem-a", oem.string()}, dir / "export.log") == 0);
+  CHECK_FALSE(fs::exists(oem / "ca.key.pem"));
+  CHECK_FALSE(fs::exists(oem / "identities" / "oem-b"));
 
   test::ChildProcess submit({"/usr/sbin/ip", "netns", "exec", n.oem_ns, CELLCTL_EXE, "submit", "--remote", "--client", "oem-a",
                              std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "--domain", domain, "--security",
