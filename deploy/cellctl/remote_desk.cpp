@@ -202,12 +202,13 @@ void RemoteDesk::take_order(Client& client, const cell::OrderRequest& request) {
   if (sequence != "search" && sequence != "paper") {
     return refuse(client, request, "sequence_strategy: '" + sequence + "' is none of search, paper", 2);
   }
-  store_order(client, request, *upload);
+  store_order(client, request, *upload, sequence);
 }
 
 // Writes the files, reads the description, hands the order to the local desk; a refusal, or
 // an error, leaves nothing behind.
-void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, const FileAssembly& upload) {
+void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, const FileAssembly& upload,
+                             const std::string& sequence) {
   const std::string submission = request.submission().to_string(), product = request.product().to_string();
   const std::string order = client.id + "-" + submission;
   const fs::path folder = cell_.state_folder() / "desk" / client.id / submission;
@@ -228,7 +229,6 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
       return refuse(client, request, relative_to(e.what(), folder / "product"), 2);
     }
     fs::create_directories(folder / "out");
-    const std::string sequence = request.sequence_strategy().to_string().empty() ? "search" : request.sequence_strategy().to_string();
     if (!store_.submit_order({order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"})) {
       fs::remove_all(folder, ignored);
       return refuse(client, request, "the cell has an order " + order + " already", 2);
@@ -243,9 +243,8 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
   accepted_.push_back({client.id, submission, request.request().to_string(), order, ""});
 }
 
-void RemoteDesk::follow(Accepted& a) {
+void RemoteDesk::follow(Accepted& a, const std::map<std::string, cell::OrderStatus>& statuses) {
   Client& client = *clients_.at(a.client);
-  const auto statuses = observer_.orders();
   if (const auto s = statuses.find(a.order); s != statuses.end()) {
     const std::string now = std::to_string(static_cast<int>(s->second.state())) + "|" + s->second.message().to_string();
     if (now != a.last_state) {
@@ -294,9 +293,11 @@ void RemoteDesk::tend() {
     }
   }
   try {
-    const auto orders = store_.orders();
+    // The database and the statuses once a round, and only while a client's order is open.
+    const auto orders = accepted_.empty() ? std::vector<state::OrderRecord>{} : store_.orders();
+    const auto statuses = accepted_.empty() ? std::map<std::string, cell::OrderStatus>{} : observer_.orders();
     for (auto it = accepted_.begin(); it != accepted_.end();) {
-      follow(*it);
+      follow(*it, statuses);
       const auto known = std::find_if(orders.begin(), orders.end(), [&](const auto& o) { return o.order == it->order; });
       if (known == orders.end() || !known->ended() || known->exit_code < 0) {
         ++it;

@@ -46,12 +46,12 @@ class RemoteDesk {
   };
 
   void take_order(Client& client, const cell::OrderRequest& request);
-  void store_order(Client& client, const cell::OrderRequest& request, const FileAssembly& upload);
+  void store_order(Client& client, const cell::OrderRequest& request, const FileAssembly& upload, const std::string& sequence);
   void refuse(Client& client, const cell::OrderRequest& request, const std::string& why, int exit_code);
   void reply(Client& client, const std::string& submission, const std::string& request, const std::string& order,
              cell::DeskState state, const std::string& message, double progress = 0, unsigned result_files = 0,
              int exit_code = 0);
-  void follow(Accepted& order);  // relays its progress
+  void follow(Accepted& order, const std::map<std::string, cell::OrderStatus>& statuses);  // relays its progress
   void finish(Accepted& order, const state::OrderRecord& record);  // the last reply and the results
 
   const CellConfig& cell_;
