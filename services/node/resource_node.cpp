@@ -274,10 +274,12 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     e.state(cell::REJECTED);
     e.reason(n.config.id + ": " + why);
     e.sim_time(n.clock.now());
+    {
+      std::lock_guard<std::mutex> lock(n.refusal_mutex);
+      n.last_overflow = c.order_id().to_string() + " " + c.command_id().to_string() + ": " + why;
+    }
+    ++n.overflowed;  // counted before it is answered: whoever hears the answer finds it counted
     n.overflow_answers->write(e);
-    ++n.overflowed;
-    std::lock_guard<std::mutex> lock(n.refusal_mutex);
-    n.last_overflow = c.order_id().to_string() + " " + c.command_id().to_string() + ": " + why;
   });
   resource.connect("commands", "IND", dev, "COMMAND");
   // Refusals counted on the listener thread while the queue was full, published once it is quiet.
