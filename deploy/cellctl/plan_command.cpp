@@ -19,6 +19,8 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string json;
     std::string gltf;
     std::string cell;
+    std::string prefer = "feasible";
+    double margin_mm = 1.0;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("plan", "Plan and validate the assembly by virtual assembly");
@@ -28,8 +30,19 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--json", options->json, "Write the plan as JSON to this file");
   cmd->add_option("--gltf", options->gltf, "Write the virtual assembly as a glTF 2.0 animation (.gltf)");
   cmd->add_option("--cell", options->cell, "Plan with this cell's gripper (its deployment file, key gripper:)");
+  cmd->add_option("--prefer", options->prefer,
+                  "What --sequence search looks for: the first feasible order, or the one with the largest least "
+                  "insertion margin")
+      ->check(CLI::IsMember({"feasible", "margin"}));
+  cmd->add_option("--margin-threshold", options->margin_mm, "A step with less room than this (mm) is a finding")
+      ->check(CLI::Range(0.0, 10.0));
   cmd->callback([options, &exit_code] {
+    if (options->prefer == "margin" && options->sequence != "search") {
+      throw CLI::ValidationError("--prefer margin", "needs --sequence search (the paper's sequence does not go back)");
+    }
     twin::PlannerOptions planning;
+    planning.objective = options->prefer == "margin" ? twin::Objective::margin : twin::Objective::feasible;
+    planning.margin_threshold = options->margin_mm / 1000;
     if (!options->cell.empty()) planning.gripper = read_cell_config(options->cell).gripper;
     sim::MeshCache meshes;
     const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);

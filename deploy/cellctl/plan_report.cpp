@@ -3,6 +3,18 @@
 #include "deploy/cellctl/text_table.hpp"
 
 namespace cellctl {
+namespace {
+
+// "0.50 back" (what the part came nearest), "0.50 tall (carriage)" (what the gripper did),
+// "> 10" (nothing within the reach).
+std::string margin_text(const twin::PlanStep& step, double reach) {
+  if (!step.margin_measured) return "-";
+  if (!step.margin) return "> " + fixed(reach * 1000, 0);
+  const twin::Margin& m = *step.margin;
+  return fixed(m.distance * 1000, 2) + " " + m.with + (m.member == "part" ? "" : " (" + m.member + ")");
+}
+
+}  // namespace
 
 void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostream& out) {
   std::size_t placed = 0;
@@ -14,7 +26,7 @@ void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostre
   out << "\n\n";
   // A subassembly's own steps read "ShaftPendulum: shaft", built aside; its insertion
   // "ShaftPendulum (shaft, pendulum)".
-  TextTable table({"step", "part", "type", "direction", "grasp", "path mm", "tries", "result"});
+  TextTable table({"step", "part", "type", "direction", "grasp", "path mm", "margin mm", "tries", "result"});
   for (std::size_t i = 0; i < plan.steps.size(); ++i) {
     const auto& step = plan.steps[i];
     const auto& part = product.parts()[step.part];
@@ -22,7 +34,8 @@ void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostre
     const std::string name = inserts || step.subassembly.empty() ? twin::step_name(product, step) : step.subassembly + ": " + part.name;
     table.add_row({std::to_string(i + 1), name, inserts ? "subassembly" : twin::short_type_name(part.type), step.trajectory.label,
                    step.trajectory.grasp.label + " (" + fixed(step.trajectory.grasp.opening * 1000, 1) + " mm)",
-                   fixed(step.trajectory.path_length() * 1000, 1), std::to_string(step.failed.size() + 1),
+                   fixed(step.trajectory.path_length() * 1000, 1), margin_text(step, plan.margin_reach),
+                   std::to_string(step.failed.size() + 1),
                    step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)"});
   }
   table.print(out);

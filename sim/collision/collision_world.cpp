@@ -84,6 +84,50 @@ struct DeepestContact : btCollisionWorld::ContactResultCallback {
   }
 };
 
+// The nearest pair of surfaces within the callback's threshold, of those `counts` keeps.
+struct NearestPoints : btCollisionWorld::ContactResultCallback {
+  const btCollisionObject* self;
+  const std::vector<std::string>& members;  // of self's children
+  const ClearanceFilter& counts;
+  std::optional<Clearance> nearest;
+
+  NearestPoints(const btCollisionObject* s, const std::vector<std::string>& m, const ClearanceFilter& c, double reach)
+      : self(s), members(m), counts(c) {
+    m_closestDistanceThreshold = static_cast<btScalar>(reach * kUnitsPerMetre);
+  }
+
+  // A box holds its margin inside its extents; hulls and triangles are grown by theirs.
+  static double grown_by(const btCollisionShape* shape) {
+    return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
+  }
+
+  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper* a, int, int,
+                           const btCollisionObjectWrapper* b, int, int) override {
+    const bool self_is_a = a->getCollisionObject() == self;
+    const btCollisionObjectWrapper* own = self_is_a ? a : b;
+    const btCollisionObjectWrapper* other = self_is_a ? b : a;
+    Clearance c;
+    c.body = other->getCollisionObject()->getUserIndex();
+    c.distance = std::max(0.0, (cp.getDistance() + grown_by(a->getCollisionShape()) + grown_by(b->getCollisionShape())) /
+                                   kUnitsPerMetre);
+    if (nearest && c.distance >= nearest->distance) return 0;
+    const btVector3 n = self_is_a ? cp.m_normalWorldOnB : -cp.m_normalWorldOnB;  // Bullet's points from B to A
+    c.normal = Eigen::Vector3d(n.x(), n.y(), n.z());
+    if (own->m_index >= 0 && own->m_index < static_cast<int>(members.size())) c.member = members[own->m_index];
+    if (counts && !counts(c)) return 0;
+    nearest = c;
+    return 0;
+  }
+};
+
+struct Overlapping : btBroadphaseAabbCallback {
+  std::vector<const btCollisionObject*> objects;
+  bool process(const btBroadphaseProxy* proxy) override {
+    objects.push_back(static_cast<const btCollisionObject*>(proxy->m_clientObject));
+    return true;
+  }
+};
+
 }  // namespace
 
 // --- MovingBody ---------------------------------------------------------------------------
@@ -347,6 +391,29 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   return deepest(body.impl_->exact_shape());
 }
 
+std::optional<Clearance> CollisionWorld::nearest(const MovingBody& body, const Pose& pose, double reach,
+                                                 const ClearanceFilter& counts) const {
+  ++checks_;
+  // Exact shapes only: a coarse hull is grown to hold its mesh and would tell too little room.
+  MovingBody::Impl::Shape& shape = body.impl_->has_exact ? body.impl_->exact_shape() : body.impl_->coarse;
+  btCollisionObject& object = shape.object;
+  object.setWorldTransform(to_bullet(pose));
+  btVector3 min, max;
+  shape.compound.getAabb(object.getWorldTransform(), min, max);
+  const btVector3 pad(reach * kUnitsPerMetre, reach * kUnitsPerMetre, reach * kUnitsPerMetre);
+  Overlapping near;
+  impl_->broadphase.aabbTest(min - pad, max + pad, near);
+  NearestPoints callback(&object, shape.member_of_child, counts, reach);
+  for (const btCollisionObject* other : near.objects) {
+    const auto& b = impl_->bodies.at(other->getUserIndex());
+    impl_->world.contactPairTest(&object, b.exact ? b.exact.get() : b.object.get(), callback);
+  }
+  if (!callback.nearest) return std::nullopt;
+  Clearance c = *callback.nearest;
+  c.body_name = impl_->bodies.at(c.body).name;
+  return c;
+}
+
 namespace {
 
 struct AnyOverlap : btBroadphaseAabbCallback {
@@ -438,6 +505,45 @@ std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose&
   };
   visit(visit, 0.0, 1.0, true);
   return hit;
+}
+
+std::optional<Clearance> CollisionWorld::nearest_along(const MovingBody& body, const Pose& from, const Pose& to,
+                                                       double reach, const ClearanceFilter& counts) const {
+  const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
+  const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
+  const btCollisionShape& shape = body.impl_->coarse.compound;
+  const double pad = (angle * body.radius() + reach) * kUnitsPerMetre;
+  std::optional<Clearance> best;
+  const auto sample = [&](double s) {
+    auto c = nearest(body, interpolate(from, to, s), reach, counts);
+    if (c && (!best || c->distance < best->distance)) {
+      c->fraction = s;
+      best = c;
+    }
+  };
+  // As sweep: a stretch whose box, grown by the reach, overlaps no body is skipped; the rest
+  // is halved down to linear_step and sampled at its ends.
+  auto visit = [&](auto&& self, double s0, double s1) -> void {
+    btVector3 min_a, max_a, min_b, max_b;
+    shape.getAabb(to_bullet(interpolate(from, to, s0)), min_a, max_a);
+    shape.getAabb(to_bullet(interpolate(from, to, s1)), min_b, max_b);
+    min_a.setMin(min_b);
+    max_a.setMax(max_b);
+    const btVector3 padding(pad, pad, pad);
+    AnyOverlap overlap;
+    impl_->broadphase.aabbTest(min_a - padding, max_a + padding, overlap);
+    if (!overlap.found) return;
+    if ((s1 - s0) * travel <= options_.linear_step) {
+      sample(s1);
+      return;
+    }
+    const double mid = (s0 + s1) / 2;
+    self(self, s0, mid);
+    self(self, mid, s1);
+  };
+  sample(0.0);
+  visit(visit, 0.0, 1.0);
+  return best;
 }
 
 }  // namespace sim

@@ -6,6 +6,7 @@
 // one-piece mesh its hull first and, where the hull penetrates, its exact triangles).
 // Touching is not colliding: only penetration deeper than the contact tolerance counts.
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,6 +35,19 @@ struct Contact {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double fraction = 0;      // where along a sweep, 0..1
 };
+
+// How near the moving body comes to a static body: the distance between their surfaces, as
+// the collision world holds them (to within the shapes' margins).
+struct Clearance {
+  BodyId body = -1;
+  std::string body_name;
+  std::string member;  // of the moving body
+  double distance = 0;  // m; 0 where they touch or overlap
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, from the static body towards the moving one
+  double fraction = 0;  // where along a move, 0..1
+};
+// Which pairs count: false leaves a pair out (a contact that is meant to be).
+using ClearanceFilter = std::function<bool(const Clearance&)>;
 
 class CollisionWorld;
 
@@ -86,6 +100,14 @@ class CollisionWorld {
   // The first collision while moving from one pose to another, translating and turning
   // together (slerp), sampled so that no point moves more than linear_step between samples.
   std::optional<Contact> sweep(const MovingBody& body, const Pose& from, const Pose& to) const;
+  // The nearest static body within `reach` of the moving body at the pose, of the pairs that
+  // `counts` (when given) keeps; nothing when none is that near.
+  std::optional<Clearance> nearest(const MovingBody& body, const Pose& pose, double reach,
+                                   const ClearanceFilter& counts = {}) const;
+  // The same along a move, sampled so that no point moves more than linear_step between
+  // samples (stretches farther than `reach` from every body are skipped whole).
+  std::optional<Clearance> nearest_along(const MovingBody& body, const Pose& from, const Pose& to, double reach,
+                                         const ClearanceFilter& counts = {}) const;
   // Penetration tests made so far (for benchmarks).
   std::size_t checks() const { return checks_; }
 

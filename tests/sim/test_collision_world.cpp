@@ -129,3 +129,53 @@ TEST_CASE("a one-piece concave part that moves is checked by its triangles, not 
     CHECK(world.sweep(frame, at(0.002, 0.1, 0), at(0.002, -0.1, 0)));
   }
 }
+
+TEST_CASE("clearance: how near a body comes, box to box, peg to hole and frame to post", "[collision][margin]") {
+  sim::CollisionWorld world;
+  world.add_static_box("wall", {0.005, 0.05, 0.05}, at(0, 0, 0));
+  const auto cube = box_body({0.01, 0.01, 0.01}, world);
+  // 5 mm between the cube's face and the wall's.
+  const auto near = world.nearest(cube, at(-0.02, 0, 0), 0.01);
+  REQUIRE(near);
+  CHECK(near->body_name == "wall");
+  CHECK(near->member == "part");
+  CHECK(near->distance == Approx(0.005).margin(1e-5));
+  CHECK(near->normal.x() == Approx(-1).margin(1e-3));  // from the wall towards the cube
+  CHECK_FALSE(world.nearest(cube, at(-0.03, 0, 0), 0.01));  // 15 mm: beyond the reach
+  // A filter leaves the pair out.
+  CHECK_FALSE(world.nearest(cube, at(-0.02, 0, 0), 0.01, [](const sim::Clearance&) { return false; }));
+  // Along a move towards the wall and past it above: the nearest is 2 mm, at the end.
+  const auto along = world.nearest_along(cube, at(-0.2, 0, 0), at(-0.017, 0, 0), 0.01);
+  REQUIRE(along);
+  CHECK(along->distance == Approx(0.002).margin(1e-5));
+  CHECK(along->fraction == Approx(1));
+  const auto over = world.nearest_along(cube, at(-0.2, 0.063, 0), at(0.2, 0.063, 0), 0.01);
+  REQUIRE(over);
+  CHECK(over->distance == Approx(0.003).margin(1e-4));  // 3 mm above the wall's top
+
+  SECTION("a round peg in its hole in Cranfield's plate: the play around it") {
+    sim::MeshCache meshes;
+    sim::CollisionWorld plate;
+    plate.add_static_mesh("back", meshes.get(products("cranfield/meshes/faceplate.obj")), at(0, 0, 0));
+    sim::MovingBody peg;
+    peg.add_mesh("part", *meshes.get(products("cranfield/meshes/round_peg.obj")), sim::Pose::Identity(),
+                 plate.options().shape_margin);
+    const auto in_hole = plate.nearest(peg, at(0, 0.005, 0.014), 0.01);
+    REQUIRE(in_hole);
+    INFO("play " << in_hole->distance * 1000 << " mm");
+    CHECK(in_hole->distance < 0.002);
+    const auto aside = plate.nearest(peg, at(0.0005, 0.005, 0.014), 0.01);  // 0.5 mm to one side
+    REQUIRE(aside);
+    CHECK(aside->distance < in_hole->distance);
+  }
+  SECTION("a one-piece concave frame around a post, 0.2 mm on every side, measured by its triangles") {
+    sim::CollisionWorld posts;
+    posts.add_static_box("post", {0.0098, 0.05, 0.0098}, at(0, 0, 0));
+    sim::MovingBody frame;
+    frame.add_mesh("part", test::one_piece_frame(0.010, 0.010, 0.010), sim::Pose::Identity(),
+                   posts.options().shape_margin);
+    const auto c = posts.nearest(frame, at(0, 0, 0), 0.01);
+    REQUIRE(c);
+    CHECK(c->distance == Approx(0.0002).margin(6e-5));
+  }
+}

@@ -193,3 +193,56 @@ TEST_CASE("a mesh in millimetres (LengthUnit mm) is placed and planned in metres
   CHECK(loaded.meshes[*loaded.product.find_part_by_name("block")]->bounds.sizes().y() == Approx(0.02));
   CHECK(test::position_mm(loaded.product, "block").y() == Approx(10));  // on the 10 mm plate
 }
+
+TEST_CASE("insertion margins: the room each part and its gripper have on the way in, seats left out",
+          "[planning][margin]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  SECTION("Cranfield: every peg has its hole's 0.5 mm of play, and that is under the 1 mm threshold") {
+    const twin::Plan p = plan(test::product("cranfield/cranfield.aml"), "search", cache, loaded);
+    REQUIRE(p.complete);
+    const auto o = order(loaded, p);
+    for (const char* peg : {"shaft", "boltA1", "boltA2", "boltR1", "boltR2"}) {
+      INFO(peg);
+      const auto& step = p.steps[at(o, peg)];
+      REQUIRE(step.margin_measured);
+      REQUIRE(step.margin);
+      CHECK(step.margin->distance == Approx(0.0005).margin(1e-5));
+      CHECK(step.margin->with == "back");
+      CHECK(step.margin->member == "part");
+      CHECK(step.margin->phase == "insert");
+      CHECK(has_finding(p, "margin", "(" + std::string(peg) + "): the part passes 0.50 mm from back while insert"));
+    }
+    // The back plate lies on the station: its seat does not count, only the fingers beside it.
+    const auto& back = p.steps[at(o, "back")];
+    REQUIRE(back.margin);
+    CHECK(back.margin->member == "finger");
+    CHECK(back.margin->distance > 0.001);
+  }
+  SECTION("a product made to differ: put in last, the short block's carriage passes 0.5 mm from the tall one") {
+    twin::PlannerOptions options;
+    loaded = twin::load_product(test::data("planning/margin/margin.aml"), cache);
+    auto s = twin::make_sequence_planner("search");
+    auto path = twin::make_path_planner("linear");
+    const twin::Plan first = twin::plan_assembly(loaded, *s, *path, options);
+    REQUIRE(first.complete);
+    REQUIRE(order(loaded, first) == std::vector<std::string>{"tall", "short"});
+    REQUIRE(first.steps[1].margin);
+    CHECK(first.steps[1].margin->member == "carriage");
+    CHECK(first.steps[1].margin->with == "tall");
+    CHECK(first.steps[1].margin->distance == Approx(0.0005).margin(1e-5));
+    CHECK_FALSE(first.steps[0].margin);  // nothing within 10 mm of the first block
+    CHECK(has_finding(first, "margin", "step 2 (short): the carriage passes 0.50 mm from tall"));
+
+    options.objective = twin::Objective::margin;
+    const twin::Plan roomy = twin::plan_assembly(loaded, *s, *path, options);
+    REQUIRE(roomy.complete);
+    CHECK(order(loaded, roomy) == std::vector<std::string>{"short", "tall"});
+    CHECK(twin::least_margin(roomy.steps, options.margin_reach) == Approx(0.0025).margin(1e-5));
+    CHECK_FALSE(has_finding(roomy, "margin", ""));
+    CHECK(has_finding(roomy, "margin-search", "least margin of 2.50 mm (the first order found: 0.50 mm)"));
+
+    options.margin_threshold = 0;  // no step is flagged
+    CHECK_FALSE(has_finding(twin::plan_assembly(loaded, *s, *path, options), "margin", ""));
+  }
+}

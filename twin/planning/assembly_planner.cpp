@@ -3,6 +3,7 @@
 #include "twin/planning/interference.hpp"
 #include "twin/planning/subassembly_planner.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -12,6 +13,10 @@
 
 namespace twin {
 namespace {
+
+// Objective::margin: an order is better only by more than this. Without it, orders whose least
+// margins differ by the mesh's rounding (Cranfield's 0.4976 and 0.5000 mm) are all searched.
+constexpr double kMarginResolution = 5e-5;  // m
 
 std::string millimetres(double metres) {
   char buffer[32];
@@ -34,6 +39,8 @@ class Search {
   Plan run() {
     plan_.sequence_planner = sequence_.name();
     plan_.path_planner = path_.name();
+    plan_.margin_threshold = options_.margin_threshold;
+    plan_.margin_reach = options_.margin_reach;
     report_meshes();
     // Overlaps in the finished product first: no path can resolve them.
     for (const Interference& i : find_interferences(product_, options_.collision).overlaps) {
@@ -46,7 +53,9 @@ class Search {
       plan_.steps.push_back(step);
     }
     plan_.complete = extend();
+    if (best_) keep_best_order();
     if (!plan_.complete && deepest_.size() > plan_.steps.size()) plan_.steps = deepest_;
+    measure_margins();
     report();
     return std::move(plan_);
   }
@@ -57,7 +66,7 @@ class Search {
 
   // Depth-first: returns true once every part is in.
   bool extend() {
-    if (plan_.steps.size() == assembled_.size()) return true;
+    if (plan_.steps.size() == assembled_.size()) return order_found();
     if (failed_states_.count(assembled_)) return false;
     const std::vector<PartIndex> allowed(scene_.frontier().begin(), scene_.frontier().end());
     for (PartIndex part : sequence_.candidates(scene_)) {
@@ -87,9 +96,15 @@ class Search {
         if (!sequence_.backtracks()) return give_up(part);
         continue;
       }
+      PlanStep step{part, std::move(*trajectory), std::move(tried), allowed, "", {}, std::nullopt, false};
+      if (options_.objective == Objective::margin) {
+        measure(step);
+        // No order through this step beats the best found: its least margin is at most this.
+        if (best_ && margin_of(step) <= best_margin_ + kMarginResolution) continue;
+      }
       assembled_[part] = true;
       scene_.assemble(part);
-      plan_.steps.push_back({part, std::move(*trajectory), std::move(tried), allowed, "", {}});
+      plan_.steps.push_back(std::move(step));
       if (extend()) return true;
       if (!sequence_.backtracks() || stopped_) return false;
       if (plan_.steps.size() > deepest_.size()) deepest_ = plan_.steps;  // the best partial plan, for the report
@@ -101,12 +116,65 @@ class Search {
       backtracked_.insert(part);
       if (plan_.backtracks >= options_.max_backtracks) {
         stopped_ = true;
-        plan_.findings.push_back({"gave-up", "the search stopped after " + std::to_string(plan_.backtracks) + " backtracks", {}});
+        if (!best_) {
+          plan_.findings.push_back({"gave-up", "the search stopped after " + std::to_string(plan_.backtracks) + " backtracks", {}});
+        }
         return false;
       }
     }
     failed_states_.insert(assembled_);
     return false;
+  }
+
+  double margin_of(const PlanStep& step) const { return step.margin ? step.margin->distance : options_.margin_reach; }
+
+  void measure(PlanStep& step) const {
+    step.margin = scene_.margin(step.part, step.trajectory, options_.margin_reach);
+    step.margin_measured = true;
+  }
+
+  // Every part in: done, unless the objective asks to look on for more room. Then the order
+  // is kept if it is the best so far, and the search goes back for another.
+  bool order_found() {
+    if (options_.objective != Objective::margin) return true;
+    const double least = least_margin(plan_.steps, options_.margin_reach);
+    ++orders_found_;
+    if (!best_) {
+      first_margin_ = least;
+      first_backtracks_ = plan_.backtracks;
+      first_backtracked_ = backtracked_;
+    }
+    if (!best_ || least > best_margin_ + kMarginResolution) {
+      best_ = plan_.steps;
+      best_margin_ = least;
+    }
+    return best_margin_ + kMarginResolution >= options_.margin_reach;  // nothing has more room than the reach
+  }
+
+  // The best order found; the backtracks the designer reads of are those it took to find
+  // the first order, the rest went into looking for more room.
+  void keep_best_order() {
+    const std::size_t explored = plan_.backtracks - first_backtracks_;
+    plan_.steps = std::move(*best_);
+    plan_.complete = true;
+    plan_.backtracks = first_backtracks_;
+    backtracked_ = first_backtracked_;
+    const std::string least = millimetres(best_margin_) + (best_margin_ >= options_.margin_reach ? " or more" : "");
+    plan_.findings.push_back(
+        {"margin-search", "the order kept has a least margin of " + least + " (the first order found: " +
+                              millimetres(first_margin_) + "); " + std::to_string(orders_found_) +
+                              " orders went together in " + std::to_string(explored) + " further backtracks" +
+                              (stopped_ ? ", when the search stopped at its limit" : ""),
+         {}});
+  }
+
+  // The margins the search did not measure: each step in the scene of the steps before it.
+  void measure_margins() {
+    for (PartIndex p = 0; p < assembled_.size(); ++p) scene_.disassemble(p);
+    for (PlanStep& step : plan_.steps) {
+      if (!step.margin_measured) measure(step);
+      scene_.assemble(step.part);
+    }
   }
 
   // A sequence that does not backtrack ends at its first part that cannot go in.
@@ -168,6 +236,16 @@ class Search {
                                       step.trajectory.label,
                                   {name(step.part), a.collision->with}});
       }
+    }
+    for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
+      const PlanStep& step = plan_.steps[i];
+      if (!step.margin || step.margin->distance >= options_.margin_threshold) continue;
+      const Margin& m = *step.margin;
+      plan_.findings.push_back({"margin",
+                                "step " + std::to_string(i + 1) + " (" + name(step.part) + "): the " + m.member +
+                                    " passes " + millimetres(m.distance) + " from " + m.with + " while " + m.phase +
+                                    ", under the " + millimetres(options_.margin_threshold) + " threshold",
+                                {name(step.part), m.with}});
     }
     if (plan_.backtracks > 0) {
       std::vector<std::string> names;
@@ -236,6 +314,11 @@ class Search {
   std::set<PartIndex> tried_;
   std::map<PartIndex, Collision> worst_;  // the deepest collision of each part's tries
   std::vector<Interference> interferences_;
+  // Objective::margin: the best order so far, and what the first one found was.
+  std::optional<std::vector<PlanStep>> best_;
+  double best_margin_ = 0, first_margin_ = 0;
+  std::size_t orders_found_ = 0, first_backtracks_ = 0;
+  std::set<PartIndex> first_backtracked_;
   bool stopped_ = false;
   std::optional<std::pair<PartIndex, std::size_t>> stopped_at_;  // the part and step a sequence ended at
 };
@@ -248,6 +331,14 @@ std::string step_name(const Product& product, const PlanStep& step) {
   std::vector<std::string> members{part};
   for (PartIndex p : step.carried) members.push_back(product.parts()[p].name);
   return step.subassembly + " (" + join(members) + ")";
+}
+
+double least_margin(const std::vector<PlanStep>& steps, double reach) {
+  double least = reach;
+  for (const PlanStep& s : steps) {
+    if (s.margin) least = std::min(least, s.margin->distance);
+  }
+  return least;
 }
 
 Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,

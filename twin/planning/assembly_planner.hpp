@@ -5,6 +5,7 @@
 // another order (if the sequence planner backtracks). The result is a plan and findings
 // for the designer.
 
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -25,6 +26,9 @@ struct PlanStep {
   // members, which move with it at their places relative to the base.
   std::string subassembly;
   std::vector<PartIndex> carried;
+  // The least room on the way in (AssemblyScene::margin); nothing: more than the reach.
+  std::optional<Margin> margin;
+  bool margin_measured = false;
 };
 
 struct SubassemblyPlan {
@@ -48,6 +52,13 @@ struct Plan {
   std::size_t backtracks = 0;
   std::size_t trajectories_simulated = 0;
   std::vector<SubassemblyPlan> subassemblies;  // each one's steps come before the step inserting it
+  double margin_threshold = 0, margin_reach = 0;  // m, as planned with (PlannerOptions)
+};
+
+// What a search that goes back looks for among the orders the links allow.
+enum class Objective {
+  feasible,  // the first order that goes together
+  margin,    // of those that do, the one whose least insertion margin is largest
 };
 
 struct PlannerOptions {
@@ -59,7 +70,13 @@ struct PlannerOptions {
   std::set<PartIndex> not_next;
   sim::CollisionOptions collision;
   fb::GripperGeometry gripper;
+  Objective objective = Objective::feasible;
+  double margin_threshold = 0.001;  // m: a step with less room is a finding
+  double margin_reach = 0.010;      // m: margins are measured up to this
 };
+
+// The least margin of the steps (the reach where none came nearer).
+double least_margin(const std::vector<PlanStep>& steps, double reach);
 
 // What a step puts in: the part's name, or for a subassembly's insertion its name and its
 // parts' ("ShaftPendulum (shaft, pendulum)").

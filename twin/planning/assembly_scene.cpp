@@ -6,6 +6,7 @@ namespace twin {
 namespace {
 
 constexpr double kOnSurface = 1e-4;  // m: a part this close to y = 0 stands on the station
+constexpr double kShortOfSeat = 1e-3;  // m: where insertion margins stop (AssemblyScene::margin)
 
 Pose translation(const Vec3& t) {
   Pose p = Pose::Identity();
@@ -134,6 +135,34 @@ std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajecto
   }
   trajectory.hold_by(own);
   return first;
+}
+
+std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& trajectory, double reach) const {
+  constexpr double kAlongInsertion = 0.7;  // cos 45°: a contact normal this near the direction is a seat's
+  const Vec3 direction = trajectory.direction;
+  const sim::ClearanceFilter counts = [&](const sim::Clearance& c) {
+    return !(c.member == "part" && c.normal.dot(direction) < -kAlongInsertion);
+  };
+  const auto& w = trajectory.waypoints;
+  const HeldPart held = hold(part, trajectory.grasp);
+  std::size_t last = 0;  // the stretch that seats the part
+  for (std::size_t i = 1; i < w.size(); ++i) last = w[i].holding ? i : last;
+  std::optional<Margin> least;
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    if (!w[i].holding) continue;
+    Pose to = w[i].part;
+    if (i == last) {
+      // Seated, the part touches what it sits on, and where faces touch flat Bullet's normal
+      // says nothing of the direction: the room is measured up to a step short of the seat.
+      const double length = (to.translation() - w[i - 1].part.translation()).norm();
+      if (length > 0) to = sim::interpolate(w[i - 1].part, to, 1 - std::min(kShortOfSeat, length / 2) / length);
+    }
+    const auto c = world_.nearest_along(held.with_arm, w[i - 1].part, to, reach, counts);
+    if (!c || (least && c->distance >= least->distance)) continue;
+    const auto name = names_.find(c->body);
+    least = Margin{c->distance, name == names_.end() ? c->body_name : name->second, c->member, w[i].phase};
+  }
+  return least;
 }
 
 Collision AssemblyScene::to_collision(const sim::Contact& contact, const std::string& phase) const {

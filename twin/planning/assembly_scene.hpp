@@ -21,6 +21,15 @@ struct Collision {
   std::string phase;    // of the trajectory; "grasp": no grasp fits the part (depth: by how much)
 };
 
+// The least room a part had on its way in: how near it, or the gripper holding it, came to
+// another body.
+struct Margin {
+  double distance = 0;  // m
+  std::string with;     // a part's name or "station"
+  std::string member;   // what came that near: "part", "finger", "palm", "carriage"
+  std::string phase;    // of the trajectory
+};
+
 // The part in the gripper, as the collision world sees it.
 struct HeldPart {
   sim::MovingBody with_arm;  // part + gripper, in the part's frame
@@ -62,6 +71,12 @@ class AssemblyScene {
   // retreat. Where none is, the trajectory keeps its own grasp and the answer is its
   // collision (or, with no grasp at all, one of phase "grasp").
   std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory) const;
+
+  // The least room the part, and the gripper holding it, have on the trajectory's way in
+  // (every stretch it is held), within `reach`: nothing when there is more. This is the room
+  // across the motion: where the part closes on a surface head-on, along the insertion
+  // direction, it is coming to its seat, meant to close, and that contact is left out.
+  std::optional<Margin> margin(PartIndex part, const Trajectory& trajectory, double reach) const;
 
   const sim::CollisionWorld& world() const { return world_; }
 

@@ -183,6 +183,8 @@ Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequ
   plan.complete = true;
   plan.sequence_planner = sequence.name();
   plan.path_planner = path.name();
+  plan.margin_threshold = options.margin_threshold;
+  plan.margin_reach = options.margin_reach;
 
   // Each subassembly built beside what stands left of it, its lowest point on the station.
   std::vector<PartIndex> all(product.product.parts().size());

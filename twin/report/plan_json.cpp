@@ -9,6 +9,14 @@ nlohmann::json quat(const Pose& p) {
   return {q.w(), q.x(), q.y(), q.z()};
 }
 
+// The least room on the way in; {"more_than": reach} where nothing came that near.
+nlohmann::json margin_json(const PlanStep& step, double reach) {
+  if (!step.margin_measured) return nullptr;
+  if (!step.margin) return {{"more_than", reach}};
+  const Margin& m = *step.margin;
+  return {{"distance", m.distance}, {"with", m.with}, {"member", m.member}, {"phase", m.phase}};
+}
+
 }  // namespace
 
 nlohmann::json plan_json(const Product& product, const Plan& plan) {
@@ -50,6 +58,7 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                      {"path_length", step.trajectory.path_length()},
                      {"tries", step.failed.size() + 1},
                      {"failed_tries", failed},
+                     {"margin", margin_json(step, plan.margin_reach)},
                      {"trajectory", trajectory}});
   }
   // The plan as a tree: the product's steps, where a subassembly's insertion holds the steps
@@ -84,6 +93,7 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
           {"sequence_planner", plan.sequence_planner},
           {"path_planner", plan.path_planner},
           {"backtracks", plan.backtracks},
+          {"margin_threshold", plan.margin_threshold},
           {"units", {{"length", "m"}}},
           {"steps", steps},
           {"tree", tree},
