@@ -10,6 +10,8 @@ packages=(
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
   libbenchmark-dev libsqlite3-dev sqlite3 libcgal-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
+  libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
+  chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
 )
 
 missing=()
@@ -35,3 +37,5 @@ fi
 # The glTF validator, pinned by tests/gltf/package-lock.json.
 cd "$(dirname "$0")/.."
 [ -d tests/gltf/node_modules/gltf-validator ] || npm ci --prefix tests/gltf --no-audit --no-fund --loglevel=error
+# puppeteer-core, which drives Debian's chromium for the report's tests (it fetches no browser).
+[ -d tests/browser/node_modules/puppeteer-core ] || npm ci --prefix tests/browser --no-audit --no-fund --loglevel=error

@@ -287,7 +287,7 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
     for (const auto& known : store.orders()) {
       if (known.order != order.id || !known.ended() || known.exit_code < 0) continue;
       observer.on_status({});
-      if (known.state == "DONE") std::cout << "order " << order.id << " done: " << out << "/plan.json, " << out << "/animation.gltf\n";
+      if (known.state == "DONE") std::cout << "order " << order.id << " done: " << out << "/report.html, " << out << "/plan.json, " << out << "/animation.gltf\n";
       if (known.state == "FAILED") std::cerr << "error: order " << order.id << ": " << known.reason << '\n';
       return known.exit_code;
     }
@@ -433,7 +433,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
     const Order& order = orders.front();
     std::cout << "twin peak RSS " << order.peak_rss_kb / 1024 << " MB\n";
-    if (order.exit_code == 0) std::cout << "order " << order.id << " done: " << order.out << "/plan.json, " << order.out << "/animation.gltf\n";
+    if (order.exit_code == 0) std::cout << "order " << order.id << " done: " << order.out << "/report.html, " << order.out << "/plan.json, " << order.out << "/animation.gltf\n";
     exit_code = order.exit_code;
   });
 

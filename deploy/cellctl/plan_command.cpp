@@ -8,6 +8,7 @@
 #include "twin/report/plan_json.hpp"
 #include "twin/geometry/product_loader.hpp"
 #include "twin/report/gltf_animation.hpp"
+#include "twin/report/html_report.hpp"
 
 namespace cellctl {
 
@@ -18,6 +19,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string path = "linear";
     std::string json;
     std::string gltf;
+    std::string report;
     std::string cell;
     std::string prefer = "feasible";
     double margin_mm = 1.0;
@@ -29,6 +31,9 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--path", options->path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   cmd->add_option("--json", options->json, "Write the plan as JSON to this file");
   cmd->add_option("--gltf", options->gltf, "Write the virtual assembly as a glTF 2.0 animation (.gltf)");
+  cmd->add_option("--report", options->report,
+                  "Write the designer's report: one HTML file with the animated virtual assembly, steps, margins, "
+                  "findings");
   cmd->add_option("--cell", options->cell, "Plan with this cell's gripper (its deployment file, key gripper:)");
   cmd->add_option("--prefer", options->prefer,
                   "What --sequence search looks for: the first feasible order, or the one with the largest least "
@@ -57,11 +62,22 @@ void add_plan_command(CLI::App& app, int& exit_code) {
       if (!out) throw std::runtime_error("cannot write " + options->json);
       std::cout << "\nwrote " << options->json << '\n';
     }
+    twin::AnimationOptions look;
+    look.gripper = planning.gripper;
+    bool wrote = !options->json.empty();
+    const auto written = [&wrote](const std::string& file) {
+      std::cout << (wrote ? "" : "\n") << "wrote " << file << '\n';
+      wrote = true;
+    };
     if (!options->gltf.empty()) {
-      twin::AnimationOptions look;
-      look.gripper = planning.gripper;
       twin::write_gltf_animation(loaded, plan, options->gltf, look);
-      std::cout << (options->json.empty() ? "\n" : "") << "wrote " << options->gltf << '\n';
+      written(options->gltf);
+    }
+    if (!options->report.empty()) {
+      twin::ReportOptions report;
+      report.look = look;
+      twin::write_html_report(loaded, plan, options->report, report);
+      written(options->report);
     }
     exit_code = plan.complete ? 0 : 1;
   });

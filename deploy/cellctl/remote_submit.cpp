@@ -172,7 +172,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     }
   }
   if (end->state() == cell::DESK_DONE) {
-    std::cout << "order " << end->order_id() << " done: " << s.out << "/plan.json, " << s.out << "/animation.gltf\n";
+    std::cout << "order " << end->order_id() << " done: " << s.out << "/report.html, " << s.out << "/plan.json, " << s.out << "/animation.gltf\n";
   } else {
     std::cerr << "error: order " << end->order_id() << ": " << end->message() << '\n';
   }

@@ -222,6 +222,17 @@ TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "
   CHECK(plans.at("order-1")["complete"] == true);
   check_event_log(read_events(dir / "events.jsonl"), plans);
   CHECK(fs::file_size(dir / "out" / "animation.gltf") > 1000);
+  // The designer's report, with the cell's run as a Gantt chart: the robot's fetches and the
+  // arm's moves, each a bar that ended as it should.
+  const std::string report = test::read_text(dir / "out" / "report.html");
+  CHECK(report.find("id=\"gantt-chart\"") != std::string::npos);
+  for (const char* resource : {">arm-1<", ">mobile-robot-1<"}) {
+    INFO(resource);
+    CHECK(report.find(resource) != std::string::npos);
+  }
+  CHECK(report.find("fetch order-1/boltA1: ") != std::string::npos);
+  CHECK(report.find(" s, succeeded</title>") != std::string::npos);
+  CHECK(report.find(" s, aborted</title>") == std::string::npos);
 }
 
 TEST_CASE("cell up: a bad order and one with a subassembly fail alone, the cell stays idle and usable, down ends it", "[process][cell]") {

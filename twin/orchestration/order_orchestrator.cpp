@@ -39,7 +39,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_input("RESOURCE_GONE", {"resource_id"});
   declare_input("AWARDED", {"call_id", "resource_id", "ahead"});
   declare_input("UNAVAILABLE", {"call_id", "reason"});
-  declare_input("COMMAND_EVENT", {"command_id", "order_id", "state", "reason"});
+  declare_input("COMMAND_EVENT", {"command_id", "order_id", "state", "reason", "sim_time"});
   declare_input("SIM_REPLY", {"request_id", "ok", "error", "collided"});
   declare_output("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
@@ -120,6 +120,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     if (get<std::string>(d, "order_id") != settings_.order_id) return;
     const std::string& id = get<std::string>(d, "command_id");
     unheard_.erase(id);
+    record(d);
     const std::string& state = get<std::string>(d, "state");
     if (const auto fetch = fetch_of_.find(id); fetch != fetch_of_.end()) {
       if (state == "succeeded") {
@@ -138,6 +139,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   });
   transition("CLEANUP", "COMMAND_EVENT", "CLEANUP", [this](const Data& d) {
     unheard_.erase(get<std::string>(d, "command_id"));
+    record(d);
     if (action_running_ && get<std::string>(d, "command_id") == awaited_id_ &&
         get<std::string>(d, "state") != "accepted" && get<std::string>(d, "state") != "executing") {
       action_done();
@@ -648,8 +650,27 @@ void OrderOrchestrator::action_done() {
 }
 
 void OrderOrchestrator::send_command(const Data& command) {
-  unheard_[get<std::string>(command, "command_id")] = {command, std::chrono::steady_clock::now()};
+  const std::string& id = get<std::string>(command, "command_id");
+  if (timeline_index_.emplace(id, timeline_.size()).second) {
+    timeline_.push_back({fb::get_or<std::string>(command, "resource_id", ""), fb::get_or<std::string>(command, "operation", ""),
+                         fb::get_or<std::string>(command, "part", ""), "", -1, -1});
+  }
+  unheard_[id] = {command, std::chrono::steady_clock::now()};
   emit("COMMAND", command);
+}
+
+void OrderOrchestrator::record(const Data& event) {
+  const auto it = timeline_index_.find(get<std::string>(event, "command_id"));
+  if (it == timeline_index_.end()) return;
+  TimelineEntry& entry = timeline_[it->second];
+  const double at = fb::get_or<double>(event, "sim_time", 0);
+  const std::string& state = get<std::string>(event, "state");
+  // A queued command runs from when it starts executing; one that never does, from its acceptance.
+  if (entry.start < 0 || state == "executing") entry.start = at;
+  if (state != "accepted" && state != "executing") {
+    entry.end = at;
+    entry.state = state;
+  }
 }
 
 void OrderOrchestrator::resend_unheard() {

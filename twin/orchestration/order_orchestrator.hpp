@@ -35,7 +35,7 @@
 //   inputs: START, TICK, CAPABILITY (resource_id, kind, position, dock, speed, angular_speed,
 //           reserved_by, waiting), RESOURCE_GONE (resource_id), AWARDED (call_id,
 //           resource_id, ahead), UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
-//           order_id, state, reason), SIM_REPLY (request_id, ok, error, collided, ...)
+//           order_id, state, reason, sim_time), SIM_REPLY (request_id, ok, error, collided, ...)
 //   outputs: CALL (to the Negotiator), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: its body, assembled in place),
@@ -52,6 +52,7 @@
 #include "services/node/sim_requests.hpp"
 #include "services/runtime/basic_block.hpp"
 #include "twin/planning/assembly_planner.hpp"
+#include "twin/report/timeline.hpp"
 
 namespace twin {
 
@@ -91,6 +92,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   const Plan& plan() const { return plan_; }
   const std::string& error() const { return error_; }
   bool take_up() const { return take_up_; }
+  // The commands sent for the order, with when each ran in sim time (its events'), in order.
+  const Timeline& timeline() const { return timeline_; }
   // Arm time of physical assembly: how long the order will hold a station, s of sim time.
   double physical_estimate() const;
 
@@ -174,6 +177,9 @@ class OrderOrchestrator : public fb::BasicBlock {
   };
   std::map<std::string, Sent> unheard_;  // commands sent that no event has answered yet
   std::map<std::string, PartIndex> fetch_of_;
+  Timeline timeline_;
+  std::map<std::string, std::size_t> timeline_index_;  // command id -> its entry
+  void record(const fb::Data& event);  // a command event: when its command ran
   std::string error_;
   bool take_up_ = false;
 };

@@ -30,6 +30,7 @@
 #include "twin/model/source_ref.hpp"
 #include "twin/orchestration/order_network.hpp"
 #include "twin/report/gltf_animation.hpp"
+#include "twin/report/html_report.hpp"
 #include "twin/report/plan_json.hpp"
 #include "services/node/run.hpp"
 #include "services/state/cell_store.hpp"
@@ -202,8 +203,15 @@ class TwinProcess {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
   }
 
-  static void write_plan(const twin::LoadedProduct& product, const twin::Plan& plan, const std::filesystem::path& file) {
+  // plan.json and, beside it, the designer's report.html (with the cell's run, once there is one).
+  void write_plan(const twin::LoadedProduct& product, const twin::Plan& plan, const std::filesystem::path& file,
+                  const twin::Timeline& timeline = {}) const {
     std::ofstream(file) << twin::plan_json(product.product, plan).dump(2) << '\n';
+    twin::ReportOptions report;
+    report.look.gripper = options_.gripper;
+    report.title = options_.order;
+    report.timeline = timeline;
+    twin::write_html_report(product, plan, file.parent_path() / "report.html", report);
   }
 
   using Inputs = std::vector<std::pair<const char*, const char*>>;  // (block, input)
@@ -255,7 +263,8 @@ class TwinProcess {
           if (options_.verbose) std::cout << "  event " << e.command_id() << " " << dds::state_name(e.state()) << " " << e.reason() << std::endl;
           return fb::Data{{"command_id", e.command_id().to_string()}, {"order_id", e.order_id().to_string()},
                           {"resource_id", e.resource_id().to_string()},
-                          {"state", std::string(dds::state_name(e.state()))}, {"reason", e.reason().to_string()}};
+                          {"state", std::string(dds::state_name(e.state()))}, {"reason", e.reason().to_string()},
+                          {"sim_time", e.sim_time()}};
         }, {{"orchestrator", "COMMAND_EVENT"}});
     subscribe<cell::SimReply, cell::SimReplyPubSubType>(
         r, "sim_replies", "cell/sim/replies", TopicKind::events, [this](const cell::SimReply& s) {
@@ -343,7 +352,7 @@ class TwinProcess {
     // made it go back), planning's and virtual assembly's findings, and the animation.
     twin::Plan validated = orchestrator.plan();
     validated.findings.insert(validated.findings.end(), findings.begin(), findings.end());
-    write_plan(product, validated, plan_file);
+    write_plan(product, validated, plan_file, orchestrator.timeline());
     const auto animation = plan_file.parent_path() / "animation.gltf";
     twin::AnimationOptions look;
     look.gripper = options_.gripper;
@@ -375,7 +384,7 @@ int main(int argc, char** argv) {
   dds::add_dds_options(app, o.dds, all_interfaces);
   app.add_option("--order", o.order, "Order id")->required();
   app.add_option("--product", o.product, "The product's AutomationML file")->required();
-  app.add_option("--out", o.out, "Folder for plan.json and animation.gltf");
+  app.add_option("--out", o.out, "Folder for report.html, plan.json and animation.gltf");
   app.add_option("--sequence", o.sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
   app.add_option("--path", o.path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);

@@ -1,6 +1,8 @@
 #include "twin/report/gltf_animation.hpp"
 
 #include <algorithm>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <stdexcept>
 
@@ -162,8 +164,8 @@ std::array<double, 4> color_rgba(const std::optional<std::string>& color) {
   return {0.6, 0.6, 0.6, 1};
 }
 
-void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const std::filesystem::path& file,
-                          const AnimationOptions& options) {
+GltfAnimation gltf_animation(const LoadedProduct& loaded, const Plan& plan, const AnimationOptions& options) {
+  GltfAnimation out;
   GltfBuilder gltf;
   const auto& parts = loaded.product.parts();
   std::map<const sim::TriangleMesh*, std::pair<int, int>> geometry;
@@ -188,6 +190,7 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
   double t = 0;
   for (const auto& step : plan.steps) {
     const auto& w = step.trajectory.waypoints;
+    out.steps.emplace_back(t, t);
     if (w.empty()) continue;
     const std::string name = "gripper (" + parts[step.part].name + ")";
     const int node = gltf.node(name, gltf.mesh(name, gltf.geometry(gripper_mesh(options.gripper, step.trajectory.grasp.opening)),
@@ -220,6 +223,7 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
       arm_track.key(t, w[i].gripper, 1);
     }
     arm_track.key(t, w.back().gripper, 0);  // gone with its step
+    out.steps.back().second = t;
   }
 
   tinygltf::Animation animation;
@@ -257,10 +261,17 @@ void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const s
   gltf.model.scenes.push_back(scene);
   gltf.model.defaultScene = 0;
 
-  tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&gltf.model, file.string(), true, true, true, false)) {
-    throw std::runtime_error("cannot write " + file.string());
-  }
+  std::ostringstream text;
+  tinygltf::TinyGLTF().WriteGltfSceneToStream(&gltf.model, text, true, false);
+  out.text = text.str();
+  return out;
+}
+
+void write_gltf_animation(const LoadedProduct& loaded, const Plan& plan, const std::filesystem::path& file,
+                          const AnimationOptions& options) {
+  std::ofstream out(file);
+  out << gltf_animation(loaded, plan, options).text;
+  if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 
 }  // namespace twin

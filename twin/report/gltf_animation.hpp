@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "twin/planning/assembly_planner.hpp"
 
@@ -20,6 +22,12 @@ struct AnimationOptions {
   double gap = 0.5;           // s between steps, while the arm moves to the next part
   fb::GripperGeometry gripper;
 };
+
+struct GltfAnimation {
+  std::string text;  // the .gltf document, buffers embedded
+  std::vector<std::pair<double, double>> steps;  // s: when each plan step starts and ends
+};
+GltfAnimation gltf_animation(const LoadedProduct& product, const Plan& plan, const AnimationOptions& options = {});
 
 // Writes a self-contained .gltf (buffers embedded). Throws std::runtime_error if it cannot.
 void write_gltf_animation(const LoadedProduct& product, const Plan& plan, const std::filesystem::path& file,
