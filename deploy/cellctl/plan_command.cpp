@@ -5,6 +5,8 @@
 
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/plan_report.hpp"
+#include "deploy/cellctl/text_table.hpp"
+#include "deploy/cellctl/video.hpp"
 #include "twin/report/plan_json.hpp"
 #include "twin/geometry/product_loader.hpp"
 #include "twin/report/gltf_animation.hpp"
@@ -20,6 +22,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string json;
     std::string gltf;
     std::string report;
+    std::string video;
     std::string cell;
     std::string prefer = "feasible";
     double margin_mm = 1.0;
@@ -34,6 +37,9 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--report", options->report,
                   "Write the designer's report: one HTML file with the animated virtual assembly, steps, margins, "
                   "findings");
+  cmd->add_option("--video", options->video,
+                  "Render the virtual assembly as an MP4 (H.264) with captions for steps and findings (needs chromium "
+                  "and ffmpeg)");
   cmd->add_option("--cell", options->cell, "Plan with this cell's gripper (its deployment file, key gripper:)");
   cmd->add_option("--prefer", options->prefer,
                   "What --sequence search looks for: the first feasible order, or the one with the largest least "
@@ -73,11 +79,15 @@ void add_plan_command(CLI::App& app, int& exit_code) {
       twin::write_gltf_animation(loaded, plan, options->gltf, look);
       written(options->gltf);
     }
+    twin::ReportOptions report;
+    report.look = look;
     if (!options->report.empty()) {
-      twin::ReportOptions report;
-      report.look = look;
       twin::write_html_report(loaded, plan, options->report, report);
       written(options->report);
+    }
+    if (!options->video.empty()) {
+      const VideoFacts video = write_video(twin::html_report(loaded, plan, report), options->video);
+      written(options->video + " (" + std::to_string(video.frames) + " frames, " + fixed(video.seconds, 1) + " s)");
     }
     exit_code = plan.complete ? 0 : 1;
   });

@@ -1,5 +1,6 @@
 #include "deploy/cellctl/processes.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -23,12 +24,21 @@ int exit_code_of(int status) {
 
 }  // namespace
 
-Process::Process(std::string name, const std::vector<std::string>& argv) : name_(std::move(name)) {
+Process::Process(std::string name, const std::vector<std::string>& argv, const std::string& stdout_to,
+                 const std::string& stderr_to)
+    : name_(std::move(name)) {
   std::vector<std::string> copy = argv;
   std::vector<char*> args;
   for (auto& a : copy) args.push_back(a.data());
   args.push_back(nullptr);
-  if (posix_spawn(&pid_, args[0], nullptr, nullptr, args.data(), environ) != 0) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  for (const auto& [fd, file] : {std::pair{STDOUT_FILENO, &stdout_to}, std::pair{STDERR_FILENO, &stderr_to}}) {
+    if (!file->empty()) posix_spawn_file_actions_addopen(&actions, fd, file->c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  }
+  const int spawned = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) {
     pid_ = -1;
     throw std::runtime_error("cannot start " + argv[0]);
   }

@@ -12,7 +12,9 @@ namespace cellctl {
 
 class Process {
  public:
-  Process(std::string name, const std::vector<std::string>& argv);
+  // `stdout_to`, `stderr_to`: files its output goes to (created, 0600), else cellctl's.
+  Process(std::string name, const std::vector<std::string>& argv, const std::string& stdout_to = "",
+          const std::string& stderr_to = "");
   ~Process();  // ends it if it still runs
   Process(const Process&) = delete;
   Process& operator=(const Process&) = delete;

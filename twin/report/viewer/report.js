@@ -193,10 +193,56 @@
     playButton.textContent = "Play";
     render();
     document.body.dataset.viewer = "ready";
+    const video = /^#video=(\d+)$/.exec(location.hash);
+    if (video) return record(Number(video[1]));
     requestAnimationFrame(tick);
   }, function (e) {
     fail("The 3D view could not be built: " + (e && e.message ? e.message : e));
   });
+
+  // The caption of a video frame, in a box at its top left: the product, then the step.
+  function drawCaption(g, text) {
+    const lines = [document.querySelector("h1").textContent].concat(text ? text.split("\n") : []);
+    const wrapped = [];
+    g.font = "16px sans-serif";
+    lines.forEach(function (line) {
+      let rest = line;
+      while (g.measureText(rest).width > canvas.width * 0.7 && rest.indexOf(" ") > 0) {
+        let cut = rest.length;
+        while (cut > 0 && g.measureText(rest.slice(0, cut)).width > canvas.width * 0.7) cut = rest.lastIndexOf(" ", cut - 1);
+        if (cut <= 0) break;
+        wrapped.push(rest.slice(0, cut));
+        rest = rest.slice(cut + 1);
+      }
+      wrapped.push(rest);
+    });
+    const width = Math.max.apply(null, wrapped.map(function (l) { return g.measureText(l).width; }));
+    g.fillStyle = "rgba(255, 255, 255, 0.85)";
+    g.fillRect(8, 8, width + 16, wrapped.length * 21 + 10);
+    g.fillStyle = "#1f2328";
+    wrapped.forEach(function (line, i) { g.fillText(line, 16, 30 + i * 21); });
+  }
+
+  // #video=FPS: every frame of the animation, and a second of the finished product, as JPEGs
+  // (base64, a line each) in <pre id="video-frames">, for cellctl plan --video.
+  function record(fps) {
+    const out = document.createElement("canvas");
+    out.width = canvas.width;
+    out.height = canvas.height;
+    const g = out.getContext("2d");
+    const count = Math.ceil(duration * fps) + fps;
+    const frames = [];
+    for (let i = 0; i < count; ++i) {
+      const text = window.agileReport.frame(Math.min(duration, i / fps));
+      g.drawImage(canvas, 0, 0);
+      drawCaption(g, text);
+      frames.push(out.toDataURL("image/jpeg", 0.9).replace(/^data:image\/jpeg;base64,/, ""));
+    }
+    const pre = document.createElement("pre");
+    pre.id = "video-frames";
+    pre.textContent = frames.join("\n");
+    document.body.appendChild(pre);
+  }
 
   // For a headless browser that records the animation: no clock of its own, a frame per call.
   window.agileReport = {
