@@ -7,6 +7,8 @@
 #include "deploy/cellctl/plan_report.hpp"
 #include "deploy/cellctl/text_table.hpp"
 #include "deploy/cellctl/video.hpp"
+#include "twin/description/automationml/precedence_writer.hpp"
+#include "twin/planning/precedence_suggestions.hpp"
 #include "twin/report/plan_json.hpp"
 #include "twin/geometry/product_loader.hpp"
 #include "twin/report/gltf_animation.hpp"
@@ -23,6 +25,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string gltf;
     std::string report;
     std::string video;
+    std::string suggest;
     std::string cell;
     std::string prefer = "feasible";
     double margin_mm = 1.0;
@@ -40,6 +43,9 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--video", options->video,
                   "Render the virtual assembly as an MP4 (H.264) with captions for steps and findings (needs chromium "
                   "and ffmpeg)");
+  cmd->add_option("--suggest", options->suggest,
+                  "Where the links leave the order open and some orders fail or leave less margin, write the product "
+                  "again to this .aml with the precedences that settle it");
   cmd->add_option("--cell", options->cell, "Plan with this cell's gripper (its deployment file, key gripper:)");
   cmd->add_option("--prefer", options->prefer,
                   "What --sequence search looks for: the first feasible order, or the one with the largest least "
@@ -60,7 +66,9 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     twin::require_geometry(loaded);
     auto sequence = twin::make_sequence_planner(options->sequence);
     auto path = twin::make_path_planner(options->path);
-    const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, planning);
+    twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, planning);
+    std::vector<twin::PrecedenceSuggestion> suggestions;
+    if (!options->suggest.empty()) suggestions = twin::suggest_precedences(loaded, plan, *sequence, *path, planning);
     print_plan(loaded.product, plan, std::cout);
     if (!options->json.empty()) {
       std::ofstream out(options->json);
@@ -84,6 +92,13 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     if (!options->report.empty()) {
       twin::write_html_report(loaded, plan, options->report, report);
       written(options->report);
+    }
+    if (!options->suggest.empty()) {
+      std::vector<std::pair<twin::PartIndex, twin::PartIndex>> rules;
+      for (const auto& s : suggestions) rules.emplace_back(s.before, s.after);
+      twin::write_with_precedences(loaded.product, rules, options->suggest);
+      written(options->suggest + " (" + std::to_string(rules.size()) + " precedence" + (rules.size() == 1 ? "" : "s") +
+              " added)");
     }
     if (!options->video.empty()) {
       const VideoFacts video = write_video(twin::html_report(loaded, plan, report), options->video);

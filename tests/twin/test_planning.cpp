@@ -3,8 +3,12 @@
 
 #include <algorithm>
 
+#include <unistd.h>
+
 #include "tests/twin/test_support.hpp"
+#include "twin/description/automationml/precedence_writer.hpp"
 #include "twin/planning/assembly_planner.hpp"
+#include "twin/planning/precedence_suggestions.hpp"
 
 namespace {
 
@@ -245,4 +249,64 @@ TEST_CASE("insertion margins: the room each part and its gripper have on the way
     options.margin_threshold = 0;  // no step is flagged
     CHECK_FALSE(has_finding(twin::plan_assembly(loaded, *s, *path, options), "margin", ""));
   }
+}
+
+TEST_CASE("suggested precedences settle the open order: written into the product, it plans the same with fewer choices",
+          "[planning][suggest]") {
+  sim::MeshCache cache;
+  const auto dir = std::filesystem::temp_directory_path() / ("suggest-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  auto sequence = twin::make_sequence_planner("search");
+  auto path = twin::make_path_planner("linear");
+  const auto count = [](const twin::Plan& p, const std::string& kind) {
+    return std::count_if(p.findings.begin(), p.findings.end(), [&](const twin::Finding& f) { return f.kind == kind; });
+  };
+  const auto replan = [&](const twin::LoadedProduct& loaded, twin::Plan& plan, const twin::PlannerOptions& options,
+                          const std::string& name) {
+    const auto suggestions = twin::suggest_precedences(loaded, plan, *sequence, *path, options);
+    std::vector<std::pair<twin::PartIndex, twin::PartIndex>> rules;
+    for (const auto& s : suggestions) rules.emplace_back(s.before, s.after);
+    twin::write_with_precedences(loaded.product, rules, dir / name);
+    return suggestions;
+  };
+
+  SECTION("an order that fails: the block must go in before the cap, or the search goes back") {
+    const auto loaded = twin::load_product(test::data("planning/backtrack/backtrack.aml"), cache);
+    twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path);
+    REQUIRE(plan.complete);
+    REQUIRE(plan.backtracks == 1);
+    const auto suggestions = replan(loaded, plan, {}, "backtrack.aml");
+    REQUIRE(suggestions.size() == 1);
+    CHECK(loaded.product.parts()[suggestions[0].before].name == "block");
+    CHECK(loaded.product.parts()[suggestions[0].after].name == "cap");
+    CHECK(has_finding(plan, "suggestion", "step 2: put block before cap: with cap there instead, no order goes together"));
+
+    const auto settled = twin::load_product(dir / "backtrack.aml", cache);  // its meshes copied beside it
+    REQUIRE(settled.product.precedences().size() == 1);
+    for (const char* planner : {"search", "paper"}) {  // the paper's sequence, which does not go back, now finishes
+      INFO(planner);
+      auto s = twin::make_sequence_planner(planner);
+      const twin::Plan again = twin::plan_assembly(settled, *s, *path);
+      REQUIRE(again.complete);
+      CHECK(order(settled, again) == order(loaded, plan));
+      CHECK(again.backtracks == 0);
+      CHECK(count(again, "open-order") < count(plan, "open-order"));
+    }
+  }
+  SECTION("an order with less margin: short before tall, as --prefer margin found") {
+    const auto loaded = twin::load_product(test::data("planning/margin/margin.aml"), cache);
+    twin::PlannerOptions options;
+    options.objective = twin::Objective::margin;
+    twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, options);
+    const auto suggestions = replan(loaded, plan, options, "margin.aml");
+    REQUIRE(suggestions.size() == 1);
+    CHECK(has_finding(plan, "suggestion", "put short before tall: with tall there instead, the least margin is 0.50 mm (2.50 mm this way)"));
+    const auto settled = twin::load_product(dir / "margin.aml", cache);
+    const twin::Plan again = twin::plan_assembly(settled, *sequence, *path);  // not even asked for margin
+    CHECK(order(settled, again) == std::vector<std::string>{"short", "tall"});
+    CHECK(count(again, "open-order") == 0);
+    CHECK(count(plan, "open-order") == 1);
+  }
+  std::filesystem::remove_all(dir);
 }

@@ -24,6 +24,7 @@ struct ItemApplier {
     product.set_type_interface(item.type, item.interface, item.frame);
   }
   void operator()(const ConnectionItem&) const {}
+  void operator()(const PrecedenceItem&) const {}
 };
 
 }  // namespace
@@ -37,6 +38,7 @@ Product build_product(const ProductDescription& description) {
     if (const auto* c = std::get_if<ConnectionItem>(&item)) {
       product.connect(c->part_a, c->interface_a, c->part_b, c->interface_b, c->name, c->where);
     }
+    if (const auto* p = std::get_if<PrecedenceItem>(&item)) product.add_precedence(p->before, p->after, p->where);
   }
   return product;
 }

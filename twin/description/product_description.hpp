@@ -46,7 +46,15 @@ struct ConnectionItem {
   SourceRef where;
 };
 
-using DescriptionItem = std::variant<CreatePartItem, ParameterItem, ConnectionItem>;
+// "precedence": one part goes in before another. An ordering constraint, never geometry
+// (docs/automationml.md, AssemblyPrecedence).
+struct PrecedenceItem {
+  std::string before;  // part IDs
+  std::string after;
+  SourceRef where;
+};
+
+using DescriptionItem = std::variant<CreatePartItem, ParameterItem, ConnectionItem, PrecedenceItem>;
 
 class ProductDescription {
  public:

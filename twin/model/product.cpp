@@ -24,7 +24,36 @@ PartIndex Product::add_part(DigitalPart part) {
   by_id_.emplace(part.id, index);
   parts_.push_back(std::move(part));
   by_part_.emplace_back();
+  predecessors_.emplace_back();
+  successors_.emplace_back();
   return index;
+}
+
+void Product::add_precedence(const std::string& before, const std::string& after, const SourceRef& where) {
+  const auto resolve = [&](const std::string& id) {
+    const auto index = find_part(id);
+    if (!index) throw DescriptionError(where, "precedence names unknown part ID '" + id + "'");
+    return *index;
+  };
+  const PartIndex first = resolve(before), then = resolve(after);
+  if (first == then) throw DescriptionError(where, "precedence puts part '" + parts_[first].name + "' before itself");
+  // A cycle: `then` already comes, directly or not, before `first`.
+  std::vector<PartIndex> open{first};
+  std::vector<bool> seen(parts_.size(), false);
+  while (!open.empty()) {
+    const PartIndex p = open.back();
+    open.pop_back();
+    if (p == then) {
+      throw DescriptionError(where, "precedence '" + parts_[first].name + "' before '" + parts_[then].name +
+                                        "' closes a cycle: the others put '" + parts_[then].name + "' first");
+    }
+    for (PartIndex q : predecessors_[p]) {
+      if (!seen[q]) open.push_back(q), seen[q] = true;
+    }
+  }
+  precedences_.emplace_back(first, then);
+  predecessors_[then].push_back(first);
+  successors_[first].push_back(then);
 }
 
 void Product::connect(const std::string& part_a, const std::string& interface_a,

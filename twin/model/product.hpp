@@ -78,6 +78,14 @@ class Product {
   void connect(const std::string& part_a, const std::string& interface_a, const std::string& part_b,
                const std::string& interface_b, const std::string& name, const SourceRef& where);
 
+  // `before` goes in before `after` (part IDs): an ordering constraint, not geometry. Throws
+  // on an unknown part, a part before itself, or a cycle of precedences.
+  void add_precedence(const std::string& before, const std::string& after, const SourceRef& where);
+  // The parts that must be in before this one.
+  const std::vector<PartIndex>& predecessors(PartIndex part) const { return predecessors_[part]; }
+  const std::vector<PartIndex>& successors(PartIndex part) const { return successors_[part]; }
+  const std::vector<std::pair<PartIndex, PartIndex>>& precedences() const { return precedences_; }
+
   std::optional<PartIndex> find_part(const std::string& id) const;
   std::optional<PartIndex> find_part_by_name(const std::string& name) const;
   // The paper's getConnectionPoint: the interface in its part's frame, the instance's own
@@ -94,6 +102,8 @@ class Product {
   std::map<std::string, PartType> types_;
   std::unordered_map<std::string, PartIndex> by_id_;
   std::vector<std::vector<std::size_t>> by_part_;
+  std::vector<std::pair<PartIndex, PartIndex>> precedences_;
+  std::vector<std::vector<PartIndex>> predecessors_, successors_;
 };
 
 // "SystemUnitClassLib1/FaceplateBack" -> "FaceplateBack"

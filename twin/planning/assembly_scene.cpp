@@ -43,6 +43,7 @@ void AssemblyScene::assemble(PartIndex part) {
   assembled_bounds_.extend(bounds_[part]);
   update_frontier(part);
   for (PartIndex neighbour : neighbours(part)) update_frontier(neighbour);
+  for (PartIndex next : product_.product.successors(part)) update_frontier(next);
 }
 
 void AssemblyScene::disassemble(PartIndex part) {
@@ -55,6 +56,7 @@ void AssemblyScene::disassemble(PartIndex part) {
   for (const auto& [p, _] : bodies_) assembled_bounds_.extend(bounds_[p]);
   update_frontier(part);
   for (PartIndex neighbour : neighbours(part)) update_frontier(neighbour);
+  for (PartIndex next : product_.product.successors(part)) update_frontier(next);
 }
 
 std::vector<PartIndex> AssemblyScene::neighbours(PartIndex part) const {
@@ -75,7 +77,9 @@ bool AssemblyScene::linked_to_assembled(PartIndex part) const {
 }
 
 void AssemblyScene::update_frontier(PartIndex part) {
-  if (!is_assembled(part) && (stands_on_surface(part) || linked_to_assembled(part))) {
+  const auto& before = product_.product.predecessors(part);
+  const bool preceded = std::all_of(before.begin(), before.end(), [&](PartIndex p) { return is_assembled(p); });
+  if (!is_assembled(part) && preceded && (stands_on_surface(part) || linked_to_assembled(part))) {
     frontier_.insert(part);
   } else {
     frontier_.erase(part);

@@ -53,7 +53,8 @@ class AssemblyScene {
   // The assembled parts' bounding box (empty when nothing is assembled).
   const Eigen::AlignedBox3d& assembled_bounds() const { return assembled_bounds_; }
   // Unassembled parts the links allow next: standing on the station's surface (which holds
-  // them) or linked to an assembled part. Kept up to date as parts come and go.
+  // them) or linked to an assembled part, and every part the product's precedences put
+  // before them in. Kept up to date as parts come and go.
   const std::set<PartIndex>& frontier() const { return frontier_; }
   bool stands_on_surface(PartIndex part) const;
 

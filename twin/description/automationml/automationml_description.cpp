@@ -16,13 +16,7 @@ using aml::child;
 using aml::for_each_child;
 using aml::local_name;
 
-// "{2DDC2CF5-...}" and "2ddc2cf5-..." are the same ID.
-std::string normalize_id(std::string_view id) {
-  if (id.size() >= 2 && id.front() == '{' && id.back() == '}') id = id.substr(1, id.size() - 2);
-  std::string out(id);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
-  return out;
-}
+using aml::normalize_id;
 
 // "BaseLib@Lib/Class" (an alias into an external file) -> "Lib/Class".
 std::string strip_alias(std::string_view path) {
@@ -183,6 +177,7 @@ class CaexReader {
     if (child(element, "InternalElement")) {  // the product or a subassembly: its children are parts
       ++out_.group_count_;
       group_ids_.insert(id);
+      read_precedences(element);
       const std::string* inner = within;
       std::string name;
       if (within == nullptr) {
@@ -211,6 +206,7 @@ class CaexReader {
   }
 
   void read_part(const pugi::xml_node& element, const std::string& id, const std::string& subassembly) {
+    read_precedences(element);  // where the parts stand at the top, with no product element
     CreatePartItem part;
     part.id = id;
     part.subassembly = subassembly;
@@ -368,6 +364,34 @@ class CaexReader {
       }
       for (auto& [_, p] : parameters) out_.items_.emplace_back(std::move(p));
     }
+  }
+
+  // --- precedences (docs/automationml.md): ordering constraints, never geometry ---------
+  //   <Attribute Name="AssemblyPrecedence">
+  //     <Attribute Name="..."><Attribute Name="Before"><Value>ID</Value></Attribute>
+  //                           <Attribute Name="After"><Value>ID</Value></Attribute></Attribute>
+
+  void read_precedences(const pugi::xml_node& element) {
+    for_each_child(element, "Attribute", [&](const pugi::xml_node& list) {
+      if (std::string_view(list.attribute("Name").value()) != "AssemblyPrecedence") return;
+      for_each_child(list, "Attribute", [&](const pugi::xml_node& rule) {
+        PrecedenceItem p;
+        p.where = file_.where(rule);
+        for (auto [name, id] : {std::pair{"Before", &p.before}, std::pair{"After", &p.after}}) {
+          pugi::xml_node side;
+          for_each_child(rule, "Attribute", [&](const pugi::xml_node& a) {
+            if (std::string_view(a.attribute("Name").value()) == name) side = a;
+          });
+          const auto text = side ? aml::attribute_text(side) : std::nullopt;
+          if (!text || text->empty()) {
+            throw DescriptionError(p.where, std::string("precedence '") + rule.attribute("Name").value() + "' has no " +
+                                                name + " (an Attribute with the part's ID as its Value)");
+          }
+          *id = normalize_id(*text);
+        }
+        out_.items_.emplace_back(std::move(p));
+      });
+    });
   }
 
   // --- links -----------------------------------------------------------------------------

@@ -1,11 +1,19 @@
 #include "twin/description/automationml/caex_values.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <map>
 #include <vector>
 
 namespace twin::aml {
+
+std::string normalize_id(std::string_view id) {
+  if (id.size() >= 2 && id.front() == '{' && id.back() == '}') id = id.substr(1, id.size() - 2);
+  std::string out(id);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
+  return out;
+}
 namespace {
 
 std::string trim(std::string_view s) {

@@ -12,6 +12,9 @@
 
 namespace twin::aml {
 
+// "{2DDC2CF5-...}" and "2ddc2cf5-..." are the same ID.
+std::string normalize_id(std::string_view id);
+
 // An Attribute's <Value>, else its <DefaultValue>, trimmed; empty when it has neither.
 std::optional<std::string> attribute_text(const pugi::xml_node& attribute);
 
