@@ -8,6 +8,10 @@
 
 #include <btBulletCollisionCommon.h>
 #include <BulletCollision/CollisionShapes/btTriangleShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
+#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 
 namespace sim {
 namespace {
@@ -84,41 +88,71 @@ struct DeepestContact : btCollisionWorld::ContactResultCallback {
   }
 };
 
-// The nearest pair of surfaces within the callback's threshold, of those `counts` keeps.
-struct NearestPoints : btCollisionWorld::ContactResultCallback {
-  const btCollisionObject* self;
-  const std::vector<std::string>& members;  // of self's children
-  const ClearanceFilter& counts;
-  std::optional<Clearance> nearest;
+// A box holds its margin inside its extents; hulls and triangles are grown by theirs.
+double grown_by(const btCollisionShape* shape) {
+  return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
+}
 
-  NearestPoints(const btCollisionObject* s, const std::vector<std::string>& m, const ClearanceFilter& c, double reach)
-      : self(s), members(m), counts(c) {
-    m_closestDistanceThreshold = static_cast<btScalar>(reach * kUnitsPerMetre);
-  }
+// The distance between two convex shapes' surfaces (Bullet units, 0 where they overlap) and
+// the normal from b towards a, by GJK (EPA where they overlap).
+std::pair<double, btVector3> convex_distance(const btConvexShape* a, const btTransform& ta, const btConvexShape* b,
+                                             const btTransform& tb) {
+  btVoronoiSimplexSolver simplex;
+  btGjkEpaPenetrationDepthSolver epa;
+  btGjkPairDetector gjk(a, b, &simplex, &epa);
+  btDiscreteCollisionDetectorInterface::ClosestPointInput input;
+  input.m_transformA = ta;
+  input.m_transformB = tb;
+  btPointCollector result;
+  gjk.getClosestPoints(input, result, nullptr);
+  if (!result.m_hasResult) return {0.0, btVector3(0, 0, 0)};
+  return {std::max(0.0, double(result.m_distance) + grown_by(a) + grown_by(b)), result.m_normalOnBInWorld};
+}
 
-  // A box holds its margin inside its extents; hulls and triangles are grown by theirs.
-  static double grown_by(const btCollisionShape* shape) {
-    return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
+// Calls `visit` with each convex piece of a static shape (a compound's children, a triangle
+// mesh's triangles) whose box comes within `box` (world), and its world transform.
+using PieceVisit = std::function<void(const btConvexShape*, const btTransform&)>;
+void static_pieces(const btCollisionShape* shape, const btTransform& world, const btVector3& min, const btVector3& max,
+                   const PieceVisit& visit) {
+  if (shape->isCompound()) {
+    const auto* compound = static_cast<const btCompoundShape*>(shape);
+    for (int i = 0; i < compound->getNumChildShapes(); ++i) {
+      const btTransform child = world * compound->getChildTransform(i);
+      btVector3 lo, hi;
+      compound->getChildShape(i)->getAabb(child, lo, hi);
+      if (TestAabbAgainstAabb2(lo, hi, min, max)) {
+        static_pieces(compound->getChildShape(i), child, min, max, visit);
+      }
+    }
+    return;
   }
-
-  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper* a, int, int,
-                           const btCollisionObjectWrapper* b, int, int) override {
-    const bool self_is_a = a->getCollisionObject() == self;
-    const btCollisionObjectWrapper* own = self_is_a ? a : b;
-    const btCollisionObjectWrapper* other = self_is_a ? b : a;
-    Clearance c;
-    c.body = other->getCollisionObject()->getUserIndex();
-    c.distance = std::max(0.0, (cp.getDistance() + grown_by(a->getCollisionShape()) + grown_by(b->getCollisionShape())) /
-                                   kUnitsPerMetre);
-    if (nearest && c.distance >= nearest->distance) return 0;
-    const btVector3 n = self_is_a ? cp.m_normalWorldOnB : -cp.m_normalWorldOnB;  // Bullet's points from B to A
-    c.normal = Eigen::Vector3d(n.x(), n.y(), n.z());
-    if (own->m_index >= 0 && own->m_index < static_cast<int>(members.size())) c.member = members[own->m_index];
-    if (counts && !counts(c)) return 0;
-    nearest = c;
-    return 0;
+  if (shape->isConcave()) {
+    // The box in the mesh's own frame: the box of the world box's corners.
+    const btTransform to_local = world.inverse();
+    btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
+    for (int c = 0; c < 8; ++c) {
+      const btVector3 corner = to_local * btVector3(c & 1 ? max.x() : min.x(), c & 2 ? max.y() : min.y(), c & 4 ? max.z() : min.z());
+      lo.setMin(corner);
+      hi.setMax(corner);
+    }
+    struct Triangles : btTriangleCallback {
+      const btCollisionShape* mesh;
+      const btTransform* world;
+      const PieceVisit* visit;
+      void processTriangle(btVector3* t, int, int) override {
+        btTriangleShape triangle(t[0], t[1], t[2]);
+        triangle.setMargin(mesh->getMargin());
+        (*visit)(&triangle, *world);
+      }
+    } triangles;
+    triangles.mesh = shape;
+    triangles.world = &world;
+    triangles.visit = &visit;
+    static_cast<const btConcaveShape*>(shape)->processAllTriangles(&triangles, lo, hi);
+    return;
   }
-};
+  visit(static_cast<const btConvexShape*>(shape), world);
+}
 
 struct Overlapping : btBroadphaseAabbCallback {
   std::vector<const btCollisionObject*> objects;
@@ -396,22 +430,44 @@ std::optional<Clearance> CollisionWorld::nearest(const MovingBody& body, const P
   ++checks_;
   // Exact shapes only: a coarse hull is grown to hold its mesh and would tell too little room.
   MovingBody::Impl::Shape& shape = body.impl_->has_exact ? body.impl_->exact_shape() : body.impl_->coarse;
-  btCollisionObject& object = shape.object;
-  object.setWorldTransform(to_bullet(pose));
+  const btTransform at = to_bullet(pose);
+  const btScalar threshold = static_cast<btScalar>(reach * kUnitsPerMetre);
+  const btVector3 pad(threshold, threshold, threshold);
   btVector3 min, max;
-  shape.compound.getAabb(object.getWorldTransform(), min, max);
-  const btVector3 pad(reach * kUnitsPerMetre, reach * kUnitsPerMetre, reach * kUnitsPerMetre);
+  shape.compound.getAabb(at, min, max);
   Overlapping near;
   impl_->broadphase.aabbTest(min - pad, max + pad, near);
-  NearestPoints callback(&object, shape.member_of_child, counts, reach);
-  for (const btCollisionObject* other : near.objects) {
-    const auto& b = impl_->bodies.at(other->getUserIndex());
-    impl_->world.contactPairTest(&object, b.exact ? b.exact.get() : b.object.get(), callback);
+  std::optional<Clearance> best;
+  // Piece by piece, GJK on each pair within reach: Bullet's own closest-point query builds a
+  // collision algorithm per call, which cost more than the distances.
+  for (int i = 0; i < shape.compound.getNumChildShapes(); ++i) {
+    const auto* piece = static_cast<const btConvexShape*>(shape.compound.getChildShape(i));
+    const btTransform piece_at = at * shape.compound.getChildTransform(i);
+    btVector3 box_lo, box_hi;
+    piece->getAabb(piece_at, box_lo, box_hi);
+    for (const btCollisionObject* other : near.objects) {
+      // Only what is nearer than the nearest so far: the box shrinks as the search goes.
+      const btScalar within = best ? static_cast<btScalar>(best->distance * kUnitsPerMetre) : threshold;
+      const btVector3 lo = box_lo - btVector3(within, within, within), hi = box_hi + btVector3(within, within, within);
+      const auto& b = impl_->bodies.at(other->getUserIndex());
+      const btCollisionObject* exact = b.exact ? b.exact.get() : b.object.get();
+      static_pieces(exact->getCollisionShape(), exact->getWorldTransform(), lo, hi,
+                    [&](const btConvexShape* against, const btTransform& against_at) {
+                      const auto [distance, normal] = convex_distance(piece, piece_at, against, against_at);
+                      const double metres = distance / kUnitsPerMetre;
+                      if (distance > threshold || (best && metres >= best->distance)) return;
+                      Clearance c;
+                      c.body = other->getUserIndex();
+                      c.distance = metres;
+                      c.normal = Eigen::Vector3d(normal.x(), normal.y(), normal.z());
+                      c.member = shape.member_of_child[static_cast<std::size_t>(i)];
+                      if (counts && !counts(c)) return;
+                      best = c;
+                    });
+    }
   }
-  if (!callback.nearest) return std::nullopt;
-  Clearance c = *callback.nearest;
-  c.body_name = impl_->bodies.at(c.body).name;
-  return c;
+  if (best) best->body_name = impl_->bodies.at(best->body).name;
+  return best;
 }
 
 namespace {
@@ -515,7 +571,8 @@ std::optional<Clearance> CollisionWorld::nearest_along(const MovingBody& body, c
   const double pad = (angle * body.radius() + reach) * kUnitsPerMetre;
   std::optional<Clearance> best;
   const auto sample = [&](double s) {
-    auto c = nearest(body, interpolate(from, to, s), reach, counts);
+    // Only what is nearer than the nearest so far matters: Bullet then leaves more pairs out.
+    auto c = nearest(body, interpolate(from, to, s), best ? best->distance : reach, counts);
     if (c && (!best || c->distance < best->distance)) {
       c->fraction = s;
       best = c;

@@ -25,14 +25,20 @@ std::filesystem::path wall_dir(int columns, int rows) {
   return dir / "wall.aml";
 }
 
-void plan_file(benchmark::State& state, const std::filesystem::path& file, const std::string& sequence) {
+// `sequence`: "paper" or "search"; "search, no margins": without insertion margins.
+void plan_file(benchmark::State& state, const std::filesystem::path& file, std::string sequence) {
   sim::MeshCache cache;
   const twin::LoadedProduct loaded = twin::load_product(file, cache);
+  twin::PlannerOptions options;
+  if (sequence == "search, no margins") {
+    sequence = "search";
+    options.margin_reach = 0;
+  }
   std::size_t trajectories = 0;
   for (auto _ : state) {
     auto s = twin::make_sequence_planner(sequence);
     auto p = twin::make_path_planner("linear");
-    const twin::Plan plan = twin::plan_assembly(loaded, *s, *p);
+    const twin::Plan plan = twin::plan_assembly(loaded, *s, *p, options);
     if (!plan.complete) state.SkipWithError("plan incomplete");
     trajectories = plan.trajectories_simulated;
   }
@@ -162,10 +168,12 @@ void BM_PegSweep(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(BM_Cranfield, paper, std::string("paper"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cranfield, search, std::string("search"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Cranfield, search_no_margins, std::string("search, no margins"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LegoTower, paper, std::string("paper"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LegoTower, search, std::string("search"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Wall, search_no_margins, std::string("search, no margins"))->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Tower, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Tower, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PegSweep)->Unit(benchmark::kMicrosecond);

@@ -129,6 +129,7 @@ class Search {
   double margin_of(const PlanStep& step) const { return step.margin ? step.margin->distance : options_.margin_reach; }
 
   void measure(PlanStep& step) const {
+    if (options_.margin_reach <= 0) return;  // margins not asked for
     step.margin = scene_.margin(step.part, step.trajectory, options_.margin_reach);
     step.margin_measured = true;
   }

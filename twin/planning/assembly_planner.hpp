@@ -72,7 +72,7 @@ struct PlannerOptions {
   fb::GripperGeometry gripper;
   Objective objective = Objective::feasible;
   double margin_threshold = 0.001;  // m: a step with less room is a finding
-  double margin_reach = 0.010;      // m: margins are measured up to this
+  double margin_reach = 0.010;      // m: margins are measured up to this; 0: not measured
 };
 
 // The least margin of the steps (the reach where none came nearer).
