@@ -5,6 +5,7 @@
 # DDS): planning, virtual assembly in cell-sim, physical assembly. Writes
 #   out/cranfield-product.json   the finished geometry
 #   out/cranfield/plan.json      the plan and the findings (schema agile-cell/plan)
+#   out/cranfield/report.html    the designer's report: 3D view, findings, margins, Gantt chart
 #   out/cranfield/animation.gltf the virtual assembly as a glTF 2.0 animation
 #   out/cranfield-events.jsonl   every command event and delivery, in sim time
 set -euo pipefail
