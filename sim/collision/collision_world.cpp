@@ -93,8 +93,8 @@ double grown_by(const btCollisionShape* shape) {
   return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
 }
 
-// The distance between two convex shapes' surfaces (Bullet units, 0 where they overlap) and
-// the normal from b towards a, by GJK (EPA where they overlap).
+// The distance between two convex shapes' surfaces (Bullet units, 0 where they overlap; huge
+// where GJK gives no answer) and the normal from b towards a, by GJK (EPA where they overlap).
 std::pair<double, btVector3> convex_distance(const btConvexShape* a, const btTransform& ta, const btConvexShape* b,
                                              const btTransform& tb) {
   btVoronoiSimplexSolver simplex;
@@ -105,7 +105,7 @@ std::pair<double, btVector3> convex_distance(const btConvexShape* a, const btTra
   input.m_transformB = tb;
   btPointCollector result;
   gjk.getClosestPoints(input, result, nullptr);
-  if (!result.m_hasResult) return {0.0, btVector3(0, 0, 0)};
+  if (!result.m_hasResult) return {BT_LARGE_FLOAT, btVector3(0, 0, 0)};  // GJK found nothing: no pair to count
   return {std::max(0.0, double(result.m_distance) + grown_by(a) + grown_by(b)), result.m_normalOnBInWorld};
 }
 
