@@ -70,19 +70,19 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::vector<twin::PrecedenceSuggestion> suggestions;
     if (!options->suggest.empty()) suggestions = twin::suggest_precedences(loaded, plan, *sequence, *path, planning);
     print_plan(loaded.product, plan, std::cout);
-    if (!options->json.empty()) {
-      std::ofstream out(options->json);
-      out << twin::plan_json(loaded.product, plan).dump(2) << '\n';
-      if (!out) throw std::runtime_error("cannot write " + options->json);
-      std::cout << "\nwrote " << options->json << '\n';
-    }
-    twin::AnimationOptions look;
-    look.gripper = planning.gripper;
-    bool wrote = !options->json.empty();
+    bool wrote = false;
     const auto written = [&wrote](const std::string& file) {
       std::cout << (wrote ? "" : "\n") << "wrote " << file << '\n';
       wrote = true;
     };
+    if (!options->json.empty()) {
+      std::ofstream out(options->json);
+      out << twin::plan_json(loaded.product, plan).dump(2) << '\n';
+      if (!out) throw std::runtime_error("cannot write " + options->json);
+      written(options->json);
+    }
+    twin::AnimationOptions look;
+    look.gripper = planning.gripper;
     if (!options->gltf.empty()) {
       twin::write_gltf_animation(loaded, plan, options->gltf, look);
       written(options->gltf);
