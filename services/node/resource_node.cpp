@@ -49,19 +49,30 @@ class CapabilityRefresh : public fb::FunctionBlock {
   void receive(const fb::Event& e) override {
     if (e.name == "LATER") {
       pending_ = false;
-      refresh_(force_);
-      force_ = false;
-      return;
+      return refresh();
     }
     force_ |= e.name == "CHANGED";
     if (pending_) return;
-    pending_ = true;
-    post_to_self("LATER");
+    try {
+      post_to_self("LATER");
+      pending_ = true;
+    } catch (const fb::EventQueueOverflow&) {
+      // A burst filled the queue: idle() refreshes. (Before, the LATER never posted left it
+      // pending for good, and the capability stopped saying what the resource refused.)
+      missed_ = true;
+    }
+  }
+  void idle() override {
+    if (missed_ && !pending_) refresh();
   }
 
  private:
+  void refresh() {
+    refresh_(force_);
+    force_ = missed_ = false;
+  }
   std::function<void(bool)> refresh_;
-  bool pending_ = false, force_ = false;
+  bool pending_ = false, force_ = false, missed_ = false;
 };
 
 
