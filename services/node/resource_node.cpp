@@ -1,5 +1,7 @@
 #include "services/node/resource_node.hpp"
 
+#include <malloc.h>
+
 #include <atomic>
 #include <mutex>
 #include <thread>
@@ -30,6 +32,8 @@ const std::pair<const char*, cell::CommandState> kLifecycleOutputs[] = {
     {"ABORTED", cell::ABORTED},   {"REJECTED", cell::REJECTED},   {"CANCELING", cell::CANCELING},
     {"CANCELED", cell::CANCELED}};
 
+constexpr std::size_t kFlood = 1000;  // refused commands between two idle moments
+
 bool is_final(cell::CommandState s) {
   return s == cell::SUCCEEDED || s == cell::ABORTED || s == cell::CANCELED || s == cell::REJECTED;
 }
@@ -57,8 +61,9 @@ class CapabilityRefresh : public fb::FunctionBlock {
       post_to_self("LATER");
       pending_ = true;
     } catch (const fb::EventQueueOverflow&) {
-      // A burst filled the queue: idle() refreshes. (Before, the LATER never posted left it
-      // pending for good, and the capability stopped saying what the resource refused.)
+      // A burst filled the queue: the next event through here, or idle() once the queue is
+      // empty, refreshes. (Before, the LATER never posted left it pending for good, and the
+      // capability stopped saying what the resource refused.)
       missed_ = true;
     }
   }
@@ -94,6 +99,7 @@ struct ResourceNode::Impl {
   std::unique_ptr<dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType>> overflow_answers;
   std::atomic<std::size_t> overflowed{0};
   std::size_t overflowed_published = 0;  // resource thread only
+  std::size_t refused_at_trim = 0;        // refusals counted at the last malloc_trim
   std::mutex refusal_mutex;
   std::string last_overflow;
   std::vector<std::function<void()>> starters;
@@ -297,6 +303,13 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.on_idle([&n] {
     n.overflow_answers->flush();
     if (n.overflowed != n.overflowed_published) n.publish_capability();
+    // Quiet after a flood of refused commands: what the flood's events and samples took is
+    // given back to the system, so that it leaves no trace in resident memory.
+    const std::size_t refused = n.device.refused() + n.overflowed;
+    if (refused - n.refused_at_trim >= kFlood) {
+      n.refused_at_trim = refused;
+      ::malloc_trim(0);
+    }
     // Now and then: has a suspended order ended, or waited too long for its twin?
     const auto now = std::chrono::steady_clock::now();
     if (n.store && now - n.last_check > std::chrono::seconds(1)) {

@@ -32,9 +32,8 @@ class FunctionBlock {
 
   // Called by the resource for each event delivered to this block.
   virtual void receive(const Event& event) = 0;
-  // Called on the resource's thread when its queue has been empty a while, and now and then
-  // while it never is: what the block could not finish within an event (a sample a slow
-  // reader had no room for) is retried here.
+  // Called on the resource's thread when its queue has been empty a while: what the block
+  // could not finish within an event (a sample a slow reader had no room for) is retried here.
   virtual void idle() {}
 
  protected:

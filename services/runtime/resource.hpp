@@ -55,10 +55,8 @@ class Resource {
   bool run_one();
   // Delivers events until none is left; returns how many.
   std::size_t run_until_idle();
-  // Waits up to `timeout` for an event and delivers it; false on time-out. Then, on time-out
-  // and at least once per `timeout` while events keep coming, does the idle work: each block's
-  // idle() and the idle hook (on this thread: what a listener thread could not post while the
-  // queue was full).
+  // Waits up to `timeout` for an event and delivers it; false on time-out, after calling the
+  // idle hook (on this thread: what a listener thread could not post while the queue was full).
   bool wait_and_run_one(std::chrono::milliseconds timeout);
   void on_idle(std::function<void()> idle);
 
@@ -78,7 +76,6 @@ class Resource {
   // would throw out of the resource's own thread and end the process.
   void enqueue(FunctionBlock& target, Event event, bool from_outside);
   void emitted(FunctionBlock& from, const std::string& output, const Data& data);
-  void run_idle_work();
 
   std::string name_;
   std::size_t capacity_;
@@ -91,7 +88,6 @@ class Resource {
   std::atomic<std::size_t> refused_{0};
   std::atomic<std::size_t> failed_{0};
   std::function<void()> idle_;
-  std::chrono::steady_clock::time_point last_idle_{};  // the resource's thread only
 };
 
 }  // namespace fb

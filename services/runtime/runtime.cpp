@@ -161,28 +161,13 @@ std::size_t Resource::run_until_idle() {
 
 bool Resource::wait_and_run_one(std::chrono::milliseconds timeout) {
   bool ready = false;
+  std::function<void()> idle;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     ready = ready_.wait_for(lock, timeout, [&] { return !queue_.empty(); });
+    if (!ready) idle = idle_;
   }
-  if (ready) run_one();
-  // A resource whose queue is never empty for `timeout` (a motion's progress, a busy sim)
-  // still does its idle work that often, else what waits for it (answers a full queue refused,
-  // the count of them) would wait as long as the load lasts.
-  const auto now = std::chrono::steady_clock::now();
-  if (!ready || now - last_idle_ >= timeout) {
-    last_idle_ = now;
-    run_idle_work();
-  }
-  return ready;
-}
-
-void Resource::run_idle_work() {
-  std::function<void()> idle;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    idle = idle_;
-  }
+  if (ready) return run_one();
   for (auto& [name, block] : blocks_) {
     try {
       block->idle();
@@ -192,6 +177,7 @@ void Resource::run_idle_work() {
     }
   }
   if (idle) idle();
+  return false;
 }
 
 void Resource::on_idle(std::function<void()> idle) {
