@@ -377,10 +377,11 @@ class CaexReader {
       for_each_child(list, "Attribute", [&](const pugi::xml_node& rule) {
         PrecedenceItem p;
         p.where = file_.where(rule);
-        for (auto [name, id] : {std::pair{"Before", &p.before}, std::pair{"After", &p.after}}) {
+        for (const auto& [name, id] : {std::pair{"Before", &p.before}, std::pair{"After", &p.after}}) {
           pugi::xml_node side;
+          const std::string_view wanted = name;  // a lambda may not capture a structured binding (C++17)
           for_each_child(rule, "Attribute", [&](const pugi::xml_node& a) {
-            if (std::string_view(a.attribute("Name").value()) == name) side = a;
+            if (std::string_view(a.attribute("Name").value()) == wanted) side = a;
           });
           const auto text = side ? aml::attribute_text(side) : std::nullopt;
           if (!text || text->empty()) {
