@@ -409,7 +409,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       const Order& order = orders.front();
       RemoteSubmission s{order.product, submit_options->client, order.id, order.out, submit_options->sequence,
                          cell.participant_settings(submit_options->client),
-                         std::chrono::seconds(static_cast<long>(cell_options->wait_s))};
+                         std::chrono::seconds(static_cast<long>(cell_options->wait_s)), false, ""};
       exit_code = submit_remote(s, stop_requested);
       return;
     }

@@ -67,9 +67,14 @@ std::vector<std::string> CellConfig::resource_ids() const {
 
 namespace {
 
+void read_cost(const std::filesystem::path& file, const YAML::Node& node, const char* key, double& cost) {
+  read(file, node, key, cost);
+  if (!std::isfinite(cost) || cost < 0) throw ConfigError(where(file, node[key]) + ": " + key + " must be a number >= 0");
+}
+
 StationConfig read_station(const std::filesystem::path& file, const YAML::Node& s) {
   if (!s.IsMap()) throw ConfigError(where(file, s) + ": a station is a map of keys");
-  known_keys(file, s, {"id", "arm", "position", "dock", "table", "arm_speed", "arm_angular_speed"});
+  known_keys(file, s, {"id", "arm", "position", "dock", "table", "arm_speed", "arm_angular_speed", "cost_per_hour"});
   StationConfig c;
   read(file, s, "id", c.id);
   read(file, s, "arm", c.arm);
@@ -79,6 +84,7 @@ StationConfig read_station(const std::filesystem::path& file, const YAML::Node& 
   read(file, s, "arm_speed", c.arm_speed);
   read(file, s, "arm_angular_speed", c.arm_angular_speed);
   if (c.arm_speed <= 0 || c.arm_angular_speed <= 0) throw ConfigError(where(file, s) + ": arm speeds must be above 0");
+  read_cost(file, s, "cost_per_hour", c.cost_per_hour);
   for (double h : c.table) {
     if (h <= 0) throw ConfigError(where(file, s["table"]) + ": a table's half extents must be above 0");
   }
@@ -87,12 +93,13 @@ StationConfig read_station(const std::filesystem::path& file, const YAML::Node& 
 
 RobotConfig read_robot(const std::filesystem::path& file, const YAML::Node& r) {
   if (!r.IsMap()) throw ConfigError(where(file, r) + ": a mobile robot is a map of keys");
-  known_keys(file, r, {"id", "home", "speed"});
+  known_keys(file, r, {"id", "home", "speed", "cost_per_hour"});
   RobotConfig c;
   read(file, r, "id", c.id);
   read_point(file, r, "home", c.home);
   read(file, r, "speed", c.speed);
   if (c.speed <= 0) throw ConfigError(where(file, r) + ": speed must be above 0");
+  read_cost(file, r, "cost_per_hour", c.cost_per_hour);
   return c;
 }
 
@@ -170,7 +177,8 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   c.file = file;
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
-              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network"});
+              "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
+              "setup_cost", "currency"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -205,6 +213,9 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, network, "peers", c.peers);
     if (c.interfaces.empty()) throw ConfigError(where(file, network) + ": network needs the host's interfaces (IPv4 addresses)");
   }
+  read_cost(file, root, "setup_cost", c.setup_cost);
+  read(file, root, "currency", c.currency);
+  if (c.currency.empty() || c.currency.size() > 8) throw ConfigError(where(file, root["currency"]) + ": currency is 1 to 8 characters");
   read(file, root, "clients", c.clients);
   for (const auto& id : c.clients) {
     if (id.empty() || id.size() > 64 || id.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos) {
@@ -309,7 +320,8 @@ void add_network(std::vector<std::string>& argv, const CellConfig& c) {
 
 std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::path& bin, const std::string& order,
                                    const std::string& product, const std::string& out, const std::string& sequence,
-                                   const std::string& path, const std::filesystem::path& state_dir, double wait_s) {
+                                   const std::string& path, const std::filesystem::path& state_dir, double wait_s,
+                                   bool quote) {
   std::vector<std::string> argv{(bin / "twin").string(), "--domain", std::to_string(c.domain), "--order", order,
                                 "--product", product, "--out", out, "--sequence", sequence, "--path", path, "--wait",
                                 std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--quiet"};
@@ -317,6 +329,11 @@ std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::p
   add_network(argv, c);
   add_security(argv, c);
   add_gripper(argv, c.gripper);
+  if (quote) {
+    argv.insert(argv.end(), {"--quote", "--setup-cost", std::to_string(c.setup_cost), "--currency", c.currency});
+    for (const auto& s : c.stations) argv.insert(argv.end(), {"--cost-per-hour", s.id + "=" + std::to_string(s.cost_per_hour)});
+    for (const auto& r : c.robots) argv.insert(argv.end(), {"--cost-per-hour", r.id + "=" + std::to_string(r.cost_per_hour)});
+  }
   return argv;
 }
 

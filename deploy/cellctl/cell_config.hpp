@@ -21,12 +21,14 @@ struct StationConfig {
   std::string id = "station-1", arm = "arm-1";
   Point position{}, dock{0.6, 0, 0}, table{1.0, 0.025, 1.0};  // table: half extents, its top at position
   double arm_speed = 0.25, arm_angular_speed = 1.0;
+  double cost_per_hour = 0;  // the station with its arm, while an order holds it (quotes)
 };
 
 struct RobotConfig {
   std::string id = "mobile-robot-1";
   Point home{1.5, 0, 1.2};
   double speed = 0.8;
+  double cost_per_hour = 0;  // while it fetches for an order (quotes)
 };
 
 struct BufferConfig {
@@ -80,6 +82,10 @@ struct CellConfig {
   // `clients: [oem-a, oem-b]`: who may submit over DDS (the order desk's topics per client).
   std::vector<std::string> clients;
   DeskLimits desk;
+  // What a quote charges (docs/quotes.md): `setup_cost:` per order, plus each resource's
+  // `cost_per_hour:` for the time the order uses it, in `currency:`.
+  double setup_cost = 0;
+  std::string currency = "EUR";
 
   std::vector<std::string> resource_ids() const;
   // How a participant of this cell with `identity` (docs/security.md) joins its domain.
@@ -105,10 +111,12 @@ struct ProcessSpec {
 // cell-sim first (the others wait for it), then the station, the robot, the buffers.
 std::vector<ProcessSpec> cell_processes(const CellConfig& cell, const std::filesystem::path& bin_dir);
 
-// The twin of one order on the cell (quiet: whoever started it shows its status); an empty
+// The twin of one order on the cell (`quote`: an order for a quote, with the cell's rates;
+// quiet: whoever started it shows its status); an empty
 // `state_dir`: the twin keeps no durable state (a cell of processes started by hand).
 std::vector<std::string> twin_argv(const CellConfig& cell, const std::filesystem::path& bin_dir, const std::string& order,
                                    const std::string& product, const std::string& out, const std::string& sequence,
-                                   const std::string& path, const std::filesystem::path& state_dir, double wait_s = 30);
+                                   const std::string& path, const std::filesystem::path& state_dir, double wait_s = 30,
+                                   bool quote = false);
 
 }  // namespace cellctl

@@ -10,6 +10,7 @@
 #include "deploy/cellctl/describe_command.hpp"
 #include "deploy/cellctl/pki_command.hpp"
 #include "deploy/cellctl/plan_command.hpp"
+#include "deploy/cellctl/quote_command.hpp"
 #include "twin/model/source_ref.hpp"
 
 int main(int argc, char** argv) {
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   cellctl::add_plan_command(app, exit_code);
   cellctl::add_cell_commands(app, exit_code);
   cellctl::add_pki_command(app, exit_code);
+  cellctl::add_quote_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

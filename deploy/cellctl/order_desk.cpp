@@ -60,7 +60,7 @@ void OrderDesk::tend() {
       // Until the twin says more: one killed before it wrote a word counts as died.
       store_.set_order(id, "SUBMITTED", o.reason);
       twins_[id] = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
-                                                                      cell_.state_folder()));
+                                                                      cell_.state_folder(), 30, o.quote));
       store_.journal("cellctl", "twin started", id, "attempt " + std::to_string(attempt));
       if (attempt > 1) log_("order " + id + ": twin started again (attempt " + std::to_string(attempt) + ")");
     } catch (const std::exception& e) {

@@ -229,7 +229,9 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
       return refuse(client, request, relative_to(e.what(), folder / "product"), 2);
     }
     fs::create_directories(folder / "out");
-    if (!store_.submit_order({order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"})) {
+    state::OrderRecord record{order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"};
+    record.quote = request.quote();
+    if (!store_.submit_order(record)) {
       fs::remove_all(folder, ignored);
       return refuse(client, request, "the cell has an order " + order + " already", 2);
     }
@@ -238,8 +240,9 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
     throw;
   }
   store_.journal("desk", "submitted", order, client.id + ": " + product + ", " + std::to_string(upload.bytes()) + " bytes");
-  log_("desk: " + client.id + "'s order " + submission + " accepted as " + order);
-  reply(client, submission, request.request().to_string(), order, cell::DESK_ACCEPTED, "order " + order + " accepted");
+  const std::string what = request.quote() ? "request for a quote " : "order ";
+  log_("desk: " + client.id + "'s " + what + submission + " accepted as " + order);
+  reply(client, submission, request.request().to_string(), order, cell::DESK_ACCEPTED, what + order + " accepted");
   accepted_.push_back({client.id, submission, request.request().to_string(), order, ""});
 }
 
@@ -262,7 +265,7 @@ void RemoteDesk::finish(Accepted& a, const state::OrderRecord& record) {
     if (it->is_regular_file(error)) results.push_back(it->path());
   }
   const bool done = record.state == "DONE";
-  reply(client, a.submission, a.request, a.order, done ? cell::DESK_DONE : cell::DESK_FAILED, done ? "assembled" : record.reason,
+  reply(client, a.submission, a.request, a.order, done ? cell::DESK_DONE : cell::DESK_FAILED, done ? (record.quote ? "quoted" : "assembled") : record.reason,
         done ? 1 : 0, static_cast<unsigned>(results.size()), record.exit_code);
   // A client that stopped reading holds the desk up to 10 s, once.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);

@@ -40,6 +40,13 @@ std::map<std::string, std::string> files_of(const fs::path& product) {
   return out;
 }
 
+// One whole line at a time: several submissions may print at once (cellctl quote).
+void say(const RemoteSubmission& s, std::ostream& to, const std::string& line) {
+  static std::mutex mutex;
+  std::lock_guard<std::mutex> lock(mutex);
+  to << s.label << line << std::endl;
+}
+
 struct Inbox {
   std::mutex mutex;
   std::condition_variable changed;
@@ -86,8 +93,9 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     return std::chrono::duration_cast<std::chrono::milliseconds>(answer_by - std::chrono::steady_clock::now());
   };
   if (!chunks.wait_for_readers(1, left()) || !orders.wait_for_readers(1, left())) {
-    std::cerr << "error: no order desk for client " << s.client << " answered on domain " << s.dds.domain_id << " within "
-              << s.wait.count() << " s (is the client in the cell's `clients:`, and its identity the cell's?)\n";
+    say(s, std::cerr, "error: no order desk for client " + s.client + " answered on domain " + std::to_string(s.dds.domain_id) +
+                          " within " + std::to_string(s.wait.count()) +
+                          " s (is the client in the cell's `clients:`, and its identity the cell's?)");
     return 3;
   }
   cell::OrderRequest request;
@@ -95,11 +103,12 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
   request.request(request_id);
   request.product(product_name);
   request.sequence_strategy(s.sequence);
+  request.quote(s.quote);
   std::uint64_t bytes = 0;
   const auto upload_by = std::chrono::steady_clock::now() + 10 * s.wait;  // the desk takes chunks at its pace
   for (const auto& [name, data] : files) {
     if (!send_file(chunks, s.submission, name, data, upload_by)) {
-      std::cerr << "error: the desk took no more of " << name << "\n";
+      say(s, std::cerr, "error: the desk took no more of " + name);
       return 3;
     }
     cell::FileDigest d;
@@ -112,10 +121,11 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
   // The order on its own topic must not overtake the last chunks on theirs.
   if (!chunks.wait_for_acknowledgments(std::chrono::duration_cast<std::chrono::milliseconds>(upload_by - std::chrono::steady_clock::now())) ||
       !orders.write(request)) {
-    std::cerr << "error: the desk did not take the order's files\n";
+    say(s, std::cerr, "error: the desk did not take the order's files");
     return 3;
   }
-  std::cout << "sent " << files.size() << " files (" << bytes << " bytes) of " << product_name << " as " << s.submission << std::endl;
+  say(s, std::cout, "sent " + std::to_string(files.size()) + " files (" + std::to_string(bytes) + " bytes) of " + product_name +
+                        " as " + s.submission);
 
   auto last_heard = std::chrono::steady_clock::now();
   std::optional<cell::DeskReply> end;
@@ -129,15 +139,16 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
       last_heard = std::chrono::steady_clock::now();
       switch (r.state()) {
         case cell::DESK_REFUSED:
-          std::cerr << "error: the desk refused the order: " << r.message() << '\n';
+          say(s, std::cerr, "error: the desk refused the order: " + r.message().to_string());
           return r.exit_code();
         case cell::DESK_ACCEPTED:
-          std::cout << r.message() << std::endl;
+          say(s, std::cout, r.message().to_string());
           accepted = true;
           break;
         case cell::DESK_PROGRESS:
           accepted = true;
-          std::cout << "[" << r.order_id() << "] " << static_cast<int>(r.progress() * 100) << "%  " << r.message() << std::endl;
+          say(s, std::cout, "[" + r.order_id().to_string() + "] " + std::to_string(static_cast<int>(r.progress() * 100)) + "%  " +
+                                r.message().to_string());
           break;
         case cell::DESK_DONE:
         case cell::DESK_FAILED:
@@ -146,7 +157,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
       }
     }
     if (!inbox.results_error.empty()) {
-      std::cerr << "error: the results came broken: " << inbox.results_error << '\n';
+      say(s, std::cerr, "error: the results came broken: " + inbox.results_error);
       return 1;
     }
     if (end && inbox.results.complete_files() >= end->result_files()) break;
@@ -154,12 +165,12 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     // long, a step not 5 minutes); results within --wait of the end.
     const auto silence = accepted && !end ? std::max<std::chrono::seconds>(s.wait, 300s) : s.wait;
     if (std::chrono::steady_clock::now() - last_heard > silence) {
-      std::cerr << "error: the desk went silent " << (end ? "before all results came" : "") << '\n';
+      say(s, std::cerr, std::string("error: the desk went silent") + (end ? " before all results came" : ""));
       return 3;
     }
   }
   if (!end) {
-    std::cout << "stopped following; the order goes on in the cell\n";
+    say(s, std::cout, "stopped following; the order goes on in the cell");
     return 0;
   }
   fs::create_directories(s.out);
@@ -167,14 +178,17 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     const fs::path file = fs::path(s.out) / fs::path(name).filename();
     std::ofstream out(file, std::ios::binary);
     if (!(out << data).flush()) {
-      std::cerr << "error: cannot write " << file.string() << '\n';
+      say(s, std::cerr, "error: cannot write " + file.string());
       return 1;
     }
   }
-  if (end->state() == cell::DESK_DONE) {
-    std::cout << "order " << end->order_id() << " done: " << s.out << "/report.html, " << s.out << "/plan.json, " << s.out << "/animation.gltf\n";
+  if (end->state() != cell::DESK_DONE) {
+    say(s, std::cerr, "error: order " + end->order_id().to_string() + ": " + end->message().to_string());
+  } else if (s.quote) {
+    say(s, std::cout, "quote " + end->order_id().to_string() + ": " + s.out + "/quote.json, " + s.out + "/report.html");
   } else {
-    std::cerr << "error: order " << end->order_id() << ": " << end->message() << '\n';
+    say(s, std::cout, "order " + end->order_id().to_string() + " done: " + s.out + "/report.html, " + s.out + "/plan.json, " +
+                          s.out + "/animation.gltf");
   }
   return end->exit_code();
 }

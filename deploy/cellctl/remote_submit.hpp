@@ -15,6 +15,8 @@ struct RemoteSubmission {
   std::string product, client, submission, out, sequence;
   dds::ParticipantSettings dds;     // the client's identity: dds.security.identity
   std::chrono::seconds wait{30};    // for the desk to answer at all
+  bool quote = false;               // a request for a quote (cellctl quote)
+  std::string label;                // put before every line it prints ("[cell-a] "): several at once
 };
 
 // Its exit code: the order's (0 assembled, 1 failed, 2 a bad description), that of a refusal

@@ -11,6 +11,7 @@ Negotiator::Negotiator(std::string name, std::string order_id, NegotiationSettin
     : FunctionBlock(std::move(name)), order_id_(std::move(order_id)), settings_(settings),
       evaluator_(std::move(evaluator)) {
   declare_input("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
+  declare_input("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_input("CAPABILITY", {"resource_id", "operations"});
   declare_input("RESOURCE_GONE", {"resource_id"});
   declare_input("PROPOSAL", {"call_id", "resource_id", "available", "reason", "earliest_start", "duration"});
@@ -20,6 +21,7 @@ Negotiator::Negotiator(std::string name, std::string order_id, NegotiationSettin
   declare_output("AWARD", {"call_id", "resource_id", "order_id", "lease"});
   declare_output("AWARDED", {"call_id", "resource_id", "ahead", "earliest_start", "duration"});
   declare_output("UNAVAILABLE", {"call_id", "reason"});
+  declare_output("QUOTED", {"call_id", "resource_id", "earliest_start", "duration"});
 }
 
 void Negotiator::receive(const Event& e) {
@@ -38,9 +40,9 @@ void Negotiator::receive(const Event& e) {
     }
     return;
   }
-  if (e.name == "CALL") {
+  if (e.name == "CALL" || e.name == "ASK") {
     Call& c = calls_[get<std::string>(e.data, "call_id")];
-    c = Call{e.data, Clock::now(), {}, {}, {}, {}, {}};
+    c = Call{e.data, Clock::now(), {}, {}, {}, {}, {}, e.name == "ASK"};
     c.data["order_id"] = order_id_;
     return call(c);
   }
@@ -58,7 +60,9 @@ void Negotiator::receive(const Event& e) {
     } else {
       c.refusals[resource] = get<std::string>(e.data, "reason");
     }
-    if (c.awarded.empty() && all_answered(c)) decide(it->first);
+    if (!c.awarded.empty() || !all_answered(c)) return;
+    const std::string id = it->first;
+    if (decide(id)) calls_.erase(id);
   } else if (e.name == "AWARD_REPLY" && resource == c.awarded) {
     if (!get<bool>(e.data, "confirmed")) return refused(it->first, resource, get<std::string>(e.data, "reason"));
     const Bid bid = c.bids[resource];
@@ -90,11 +94,11 @@ void Negotiator::refused(const std::string& id, const std::string& resource, con
   c.bids.erase(resource);
   c.refusals[resource] = reason;
   c.awarded.clear();
-  decide(id);
+  decide(id);  // an award's refusal: never a call for quotes
 }
 
-// The best bid is awarded; with none, the call waits for the next one or runs out.
-void Negotiator::decide(const std::string& id) {
+// The best bid is awarded (or quoted); with none, the call waits for the next one or runs out.
+bool Negotiator::decide(const std::string& id) {
   Call& c = calls_.at(id);
   const Bid* best = nullptr;
   double best_cost = std::numeric_limits<double>::infinity();
@@ -102,15 +106,21 @@ void Negotiator::decide(const std::string& id) {
     const double cost = evaluator_->cost(bid);
     if (cost < best_cost) best = &bid, best_cost = cost;
   }
-  if (!best) return;
+  if (!best) return false;
+  if (c.quote) {
+    emit("QUOTED", {{"call_id", id}, {"resource_id", best->resource_id}, {"earliest_start", best->earliest_start},
+                    {"duration", best->duration}});
+    return true;
+  }
   c.awarded = best->resource_id;
   c.awarded_at = Clock::now();
   emit("AWARD", {{"call_id", id}, {"resource_id", c.awarded}, {"order_id", order_id_}, {"lease", settings_.lease_s}});
+  return false;
 }
 
 void Negotiator::tick() {
   const auto now = Clock::now();
-  std::vector<std::string> unavailable;
+  std::vector<std::string> unavailable, quoted;
   for (auto& [id, c] : calls_) {
     if (!c.awarded.empty()) {
       if (now - c.awarded_at > settings_.reply_timeout) {
@@ -120,33 +130,37 @@ void Negotiator::tick() {
       continue;
     }
     if (!c.bids.empty() && now - c.called >= settings_.window) {
-      decide(id);
-    } else if (c.bids.empty() && now - c.started >= settings_.wait) {
+      if (decide(id)) quoted.push_back(id);
+    } else if (c.bids.empty() && (now - c.started >= settings_.wait ||
+                                  (c.quote && now - c.started >= settings_.quote_patience && all_answered(c)))) {
       unavailable.push_back(id);
     } else if (c.bids.empty() && now - c.called >= settings_.retry) {
       call(c);
     }
   }
-  for (const auto& id : unavailable) {
-    const Call& c = calls_.at(id);
-    std::string reason = "nobody offered " + get<std::string>(c.data, "operation");
-    const std::string type = get_or<std::string>(c.data, "part_type", "");
-    if (!type.empty()) reason += " " + type;
-    reason += " within " + std::to_string(settings_.wait.count() / 1000) + " s";
-    std::string why;
-    for (const auto& [resource, r] : c.refusals) why += (why.empty() ? "" : "; ") + resource + ": " + r;
-    // A live resource that offers the operation and said nothing at all: its answers do not
-    // reach this process (a DDS match lost under load), which the operator should know.
-    const std::string& operation = get<std::string>(c.data, "operation");
-    for (const auto& [resource, ops] : operations_) {
-      if (ops.count(operation) && !c.refusals.count(resource)) {
-        why += (why.empty() ? "" : "; ") + resource + " offers " + operation + " but never answered";
-      }
+  for (const auto& id : quoted) calls_.erase(id);
+  for (const auto& id : unavailable) this->unavailable(id);
+}
+
+void Negotiator::unavailable(const std::string& id) {
+  const Call& c = calls_.at(id);
+  std::string reason = "nobody offered " + get<std::string>(c.data, "operation");
+  const std::string type = get_or<std::string>(c.data, "part_type", "");
+  if (!type.empty()) reason += " " + type;
+  if (!c.quote || c.refusals.empty()) reason += " within " + std::to_string(settings_.wait.count() / 1000) + " s";
+  std::string why;
+  for (const auto& [resource, r] : c.refusals) why += (why.empty() ? "" : "; ") + resource + ": " + r;
+  // A live resource that offers the operation and said nothing at all: its answers do not
+  // reach this process (a DDS match lost under load), which the operator should know.
+  const std::string& operation = get<std::string>(c.data, "operation");
+  for (const auto& [resource, ops] : operations_) {
+    if (ops.count(operation) && !c.refusals.count(resource)) {
+      why += (why.empty() ? "" : "; ") + resource + " offers " + operation + " but never answered";
     }
-    reason += why.empty() ? " (no resource with that operation answered)" : " (" + why + ")";
-    calls_.erase(id);
-    emit("UNAVAILABLE", {{"call_id", id}, {"reason", reason}});
   }
+  reason += why.empty() ? " (no resource with that operation answered)" : " (" + why + ")";
+  calls_.erase(id);
+  emit("UNAVAILABLE", {{"call_id", id}, {"reason", reason}});
 }
 
 }  // namespace fb

@@ -7,9 +7,15 @@
 // wait runs out; then it is UNAVAILABLE, with every refusal's reason. The block knows no
 // products: a call is an operation and its parameters.
 //
+// ASK is a call for quotes: the same bidding, and the best bid is reported (QUOTED) instead of
+// awarded, so that an order can learn what the cell would offer without taking anything. A
+// call for quotes that every resource with the operation refused is UNAVAILABLE after
+// `quote_patience` (a resource discovered late may still bid), not after the whole `wait`.
+//
 //   inputs                                          outputs
 //   CALL (call_id, operation, part_type, station,   CFP (the call, with order_id)
 //         sources, count, duration)                 AWARD (call_id, resource_id, order_id, lease)
+//   ASK (as CALL: a call for quotes)                QUOTED (call_id, resource_id, earliest_start, duration)
 //   CAPABILITY (resource_id, operations): who       AWARDED (call_id, resource_id, ahead,
 //     may answer                                             earliest_start, duration)
 //   RESOURCE_GONE (resource_id)                     UNAVAILABLE (call_id, reason)
@@ -52,6 +58,7 @@ struct NegotiationSettings {
   std::chrono::milliseconds reply_timeout{2000};  // for a confirmation of an award
   std::chrono::milliseconds retry{1000};        // call again when nobody bid
   std::chrono::milliseconds wait{30000};        // then the call is UNAVAILABLE
+  std::chrono::milliseconds quote_patience{3000};  // a call for quotes everyone refused
   double lease_s = 10;
 };
 
@@ -71,9 +78,12 @@ class Negotiator : public FunctionBlock {
     std::map<std::string, Bid> bids;
     std::map<std::string, std::string> refusals;  // resource -> why
     std::string awarded;                          // waiting for its reply
+    bool quote = false;                           // ASK: the best bid is reported, not awarded
   };
   void call(Call& c);
-  void decide(const std::string& id);
+  // Awards the best bid, or reports it for a call for quotes (which ends the call: true).
+  bool decide(const std::string& id);
+  void unavailable(const std::string& id);
   void tick();
   bool all_answered(const Call& c) const;
   void refused(const std::string& id, const std::string& resource, const std::string& reason);

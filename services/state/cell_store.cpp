@@ -31,7 +31,8 @@ CREATE INDEX IF NOT EXISTS bookings_of ON bookings(resource);
 CREATE TABLE IF NOT EXISTS orders(
   order_id TEXT PRIMARY KEY, state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '', updated REAL,
   product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', sequence TEXT NOT NULL DEFAULT '',
-  path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0);
+  path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0,
+  quote INTEGER NOT NULL DEFAULT 0);
 CREATE TABLE IF NOT EXISTS journal(
   seq INTEGER PRIMARY KEY AUTOINCREMENT, time REAL NOT NULL, source TEXT NOT NULL, event TEXT NOT NULL,
   order_id TEXT NOT NULL, detail TEXT NOT NULL);
@@ -148,6 +149,7 @@ CellStore::CellStore(const std::filesystem::path& dir) {
       exec("PRAGMA foreign_keys=ON");
       Transaction t(*this);
       exec(kSchema);
+      add_columns_of_later_versions();
       t.commit();
       return;
     } catch (const StoreError&) {
@@ -166,6 +168,12 @@ CellStore::CellStore(const std::filesystem::path& dir) {
 }
 
 CellStore::~CellStore() { sqlite3_close(db_); }
+
+// A database written before a column existed gets it, with its default.
+void CellStore::add_columns_of_later_versions() {
+  Statement columns(db_, "SELECT 1 FROM pragma_table_info('orders') WHERE name = 'quote'");
+  if (!columns.step()) exec("ALTER TABLE orders ADD COLUMN quote INTEGER NOT NULL DEFAULT 0");
+}
 
 void CellStore::exec(const char* sql) const {
   char* error = nullptr;
@@ -426,9 +434,9 @@ std::map<std::string, std::string> CellStore::holders() const {
 }
 
 bool CellStore::submit_order(const OrderRecord& o) {
-  Statement(db_, "INSERT OR IGNORE INTO orders(order_id, state, updated, product, out_dir, sequence, path_planner) "
-                 "VALUES(?, 'SUBMITTED', ?, ?, ?, ?, ?)")
-      .bind(o.order, unix_now(), o.product, o.out, o.sequence, o.path)
+  Statement(db_, "INSERT OR IGNORE INTO orders(order_id, state, updated, product, out_dir, sequence, path_planner, quote) "
+                 "VALUES(?, 'SUBMITTED', ?, ?, ?, ?, ?, ?)")
+      .bind(o.order, unix_now(), o.product, o.out, o.sequence, o.path, o.quote ? 1 : 0)
       .step();
   return sqlite3_changes(db_) == 1;
 }
@@ -453,11 +461,11 @@ int CellStore::count_attempt(const std::string& order) {
 
 std::vector<OrderRecord> CellStore::orders() const {
   Statement rows(db_, "SELECT order_id, state, reason, product, out_dir, sequence, path_planner, IFNULL(exit_code, -1), "
-                      "attempts FROM orders ORDER BY order_id");
+                      "attempts, quote FROM orders ORDER BY order_id");
   std::vector<OrderRecord> out;
   while (rows.step()) {
     out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(4), rows.text(5), rows.text(6),
-                   static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8))});
+                   static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8)), rows.integer(9) != 0});
   }
   return out;
 }

@@ -63,6 +63,7 @@ struct OrderRecord {
   std::string order, state, reason, product, out, sequence, path;
   int exit_code = -1;
   int attempts = 0;
+  bool quote = false;  // an order for a quote: virtual assembly only (docs/quotes.md)
   bool ended() const;  // DONE or FAILED
 };
 
@@ -154,6 +155,7 @@ class CellStore {
   class Statement;
   class Transaction;
   void exec(const char* sql) const;
+  void add_columns_of_later_versions();
   std::vector<PartRecord> parts_held(const std::string& holder, Place place) const;
   void move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
                  const char* from);

@@ -166,6 +166,37 @@ TEST_CASE("negotiator: once every capable resource answered, the earliest finish
   CHECK(f.block().open_calls() == 0);
 }
 
+TEST_CASE("negotiator: a call for quotes reports the best bid and awards nothing, and one all refused ends soon",
+          "[fb][negotiation]") {
+  fb::NegotiationSettings settings;
+  settings.quote_patience = std::chrono::milliseconds(50);
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", settings);
+  f.send("CAPABILITY", capability("robot-1", "fetch"));
+  f.send("CAPABILITY", capability("robot-2", "fetch"));
+  f.send("CAPABILITY", capability("buffer-1", "give"));
+  REQUIRE(names<fb::Negotiator>(f.send("ASK", cfp("o1", "fetch"))) == Names{"CFP"});
+  CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 10, 30)).empty());
+  const auto quoted = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 20, 5));
+  REQUIRE(names<fb::Negotiator>(quoted) == Names{"QUOTED"});
+  CHECK(fb::get<std::string>(quoted[0].data, "resource_id") == "robot-2");
+  CHECK(fb::get<double>(quoted[0].data, "earliest_start") == 20);
+  CHECK(fb::get<double>(quoted[0].data, "duration") == 5);
+  CHECK(f.block().open_calls() == 0);
+  CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 1)).empty());  // late: the call is settled
+
+  // Every resource that offers it says no: unavailable with the reasons after the patience,
+  // long before the wait (30 s); a resource heard of meanwhile could still have bid.
+  f.send("ASK", cfp("o1", "give"));
+  CHECK(f.send("PROPOSAL", {{"call_id", std::string("o1/give")}, {"resource_id", std::string("buffer-1")},
+                            {"available", false}, {"reason", std::string("buffer-1 has no Shaft")},
+                            {"earliest_start", 0.0}, {"duration", 0.0}}).empty());
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  const auto out = f.send("TICK");
+  REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
+  CHECK(fb::get<std::string>(out[0].data, "reason") == "nobody offered give (buffer-1: buffer-1 has no Shaft)");
+  CHECK(f.block().open_calls() == 0);
+}
+
 TEST_CASE("negotiator: a bid evaluator of the cell's own decides", "[fb][negotiation]") {
   struct ShortestWork : fb::BidEvaluator {
     double cost(const fb::Bid& bid) const override { return bid.duration; }

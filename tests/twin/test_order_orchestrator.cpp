@@ -3,6 +3,8 @@
 // what the test says.
 
 #include <functional>
+#include <numeric>
+#include <optional>
 
 #include <catch2/catch.hpp>
 
@@ -18,7 +20,7 @@ using fb::get;
 class Outbox : public fb::FunctionBlock {
  public:
   Outbox() : FunctionBlock("outbox") {
-    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "FINISHED", "CFP", "AWARD"}) {
+    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "QUOTE", "FINISHED", "CFP", "AWARD"}) {
       declare_input(e);
     }
   }
@@ -27,12 +29,15 @@ class Outbox : public fb::FunctionBlock {
 };
 
 struct Twin {
-  Twin(const twin::LoadedProduct& product, const twin::Plan& plan) : resource("twin", 4096) {
+  Twin(const twin::LoadedProduct& product, const twin::Plan& plan, bool quote_only = false) : resource("twin", 4096) {
     twin::OrderSettings order;
     order.order_id = "o1";
-    orchestrator = &twin::add_order_network(resource, product, plan, order, fb::NegotiationSettings{});
+    order.quote_only = quote_only;
+    fb::NegotiationSettings negotiation;
+    negotiation.quote_patience = std::chrono::milliseconds(0);  // a refused call for quotes ends at the next TICK
+    orchestrator = &twin::add_order_network(resource, product, plan, order, negotiation);
     outbox = &resource.add(std::make_unique<Outbox>());
-    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "FINISHED"}) {
+    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "QUOTE", "FINISHED"}) {
       resource.connect("orchestrator", e, "outbox", e);
     }
     for (const char* e : {"CFP", "AWARD"}) resource.connect("negotiator", e, "outbox", e);
@@ -55,6 +60,7 @@ struct Outcome {
   std::vector<std::string> statuses;  // messages
   std::vector<std::string> order;     // what went out: "SIM spawn", "CFP host", ...
   std::vector<Data> grips;            // the grip commands
+  std::optional<Data> quote;
   bool finished = false, complete = false;
   std::string error;
 };
@@ -66,6 +72,7 @@ const std::string kNoAnswer = "(no answer)";
 struct Cell {
   std::function<bool(const Data&, long)> collide = [](const Data&, long) { return false; };
   std::function<std::string(const Data&)> refuse = [](const Data&) { return std::string(); };
+  std::function<std::string(const Data&)> refuse_call = [](const Data&) { return std::string(); };  // a CFP
   long ahead = 0;
 };
 
@@ -86,8 +93,13 @@ Outcome run(Twin& t, const Cell& cell) {
   capability("mobile-robot-1", "mobile-robot", "fetch", "");
   capability("buffer-1", "buffer", "give", "");
   std::vector<fb::Event> pending = t.send("orchestrator", "START");
-  bool queued_reported = false;
+  bool queued_reported = false, ticked = false;
   for (int guard = 0; guard < 100000; ++guard) {
+    if (pending.empty() && !out.finished && !ticked) {
+      ticked = true;
+      pending = t.send("negotiator", "TICK");
+      continue;
+    }
     if (pending.empty()) {
       // The station's queue moves on once the order has said it waits.
       if (cell.ahead == 0 || !queued_reported || out.finished) break;
@@ -103,10 +115,14 @@ Outcome run(Twin& t, const Cell& cell) {
       out.order.push_back("CFP " + op);
       const std::string resource = op == "host" ? "station-1" : op == "translate" ? "arm-1"
                                  : op == "fetch" ? "mobile-robot-1" : "buffer-1";
+      const std::string no = cell.refuse_call(e.data);
       more = t.send("negotiator", "PROPOSAL", {{"call_id", e.data.at("call_id")}, {"resource_id", resource},
-                                               {"available", true}, {"reason", std::string()},
+                                               {"available", no.empty()}, {"reason", no},
                                                {"earliest_start", 0.0}, {"duration", 1.0}});
+    } else if (e.name == "QUOTE") {
+      out.quote = e.data;
     } else if (e.name == "AWARD") {
+      out.order.push_back("AWARD");
       const bool host = get<std::string>(e.data, "resource_id") == "station-1";
       more = t.send("negotiator", "AWARD_REPLY", {{"call_id", e.data.at("call_id")},
                                                   {"resource_id", e.data.at("resource_id")}, {"confirmed", true},
@@ -274,4 +290,44 @@ TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not 
   std::sort(unanswered.begin(), unanswered.end());
   CHECK(out.canceled == unanswered);  // both in the order of their ids
   CHECK(unanswered.size() == lego.plan.steps.size() - 2);
+}
+
+TEST_CASE("orchestrator: an order for a quote assembles virtually, asks for bids, and takes nothing", "[twin][orchestration][quote]") {
+  const Planned cranfield("cranfield/cranfield.aml");
+  Twin t(cranfield.product, cranfield.plan, true);
+  const Outcome out = run(t, Cell{});
+  INFO(out.error);
+  CHECK(out.complete);
+  CHECK(std::count(out.order.begin(), out.order.end(), "SIM set_static") == static_cast<long>(cranfield.plan.steps.size()));
+  CHECK(std::find(out.order.begin(), out.order.end(), "AWARD") == out.order.end());
+  CHECK(std::none_of(out.order.begin(), out.order.end(), [](const std::string& s) { return s.rfind("COMMAND", 0) == 0; }));
+  CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") != out.order.end());
+  CHECK(std::find(out.order.begin(), out.order.end(), "CFP fetch") != out.order.end());
+  REQUIRE(out.quote);
+  const Data& q = *out.quote;
+  CHECK(get<std::string>(q, "station") == "station-1");
+  CHECK(get<std::string>(q, "robot") == "mobile-robot-1");
+  const auto& fetch = get<fb::Numbers>(q, "fetch");
+  const auto& arm = get<fb::Numbers>(q, "arm");
+  REQUIRE(fetch.size() == cranfield.plan.steps.size());
+  REQUIRE(arm.size() == cranfield.plan.steps.size());
+  // The robot's bid (1 s for the batch) shared among the fetches; the arm's time per step
+  // adds up to what the order would ask the station for.
+  CHECK(std::accumulate(fetch.begin(), fetch.end(), 0.0) == Approx(1.0));
+  CHECK(std::accumulate(arm.begin(), arm.end(), 0.0) == Approx(t.orchestrator->physical_estimate()));
+  CHECK(std::all_of(arm.begin(), arm.end(), [](double a) { return a > 0; }));
+}
+
+TEST_CASE("orchestrator: a quote nobody can bid on ends with every refusal's reason", "[twin][orchestration][quote]") {
+  const Planned lego("lego-tower/lego-tower.aml");
+  Twin t(lego.product, lego.plan, true);
+  Cell cell;
+  cell.refuse_call = [](const Data& call) {
+    return get<std::string>(call, "part_type") == "Brick2x2" ? std::string("buffer-1 has 0 Brick2x2 free, not 4") : "";
+  };
+  const Outcome out = run(t, cell);
+  CHECK(out.finished);
+  CHECK_FALSE(out.quote);
+  CHECK(out.error.find("buffer-1 has 0 Brick2x2 free") != std::string::npos);
+  CHECK(std::find(out.order.begin(), out.order.end(), "AWARD") == out.order.end());
 }

@@ -6,7 +6,7 @@
 //
 //   into "orchestrator": START, TICK, CAPABILITY, RESOURCE_GONE, COMMAND_EVENT, SIM_REPLY
 //   into "negotiator":   TICK, CAPABILITY, RESOURCE_GONE, PROPOSAL, AWARD_REPLY
-//   out of "orchestrator": RELEASE, COMMAND, CANCEL, SIM, STATUS, FINDING, FINISHED
+//   out of "orchestrator": RELEASE, COMMAND, CANCEL, SIM, STATUS, FINDING, PLACED, QUOTE, FINISHED
 //   out of "negotiator":   CFP, AWARD
 
 #include <memory>
@@ -24,7 +24,9 @@ inline OrderOrchestrator& add_order_network(fb::Resource& resource, const Loaded
   auto& orchestrator = resource.add(std::make_unique<OrderOrchestrator>("orchestrator", product, plan, order));
   resource.add(std::make_unique<fb::Negotiator>("negotiator", order.order_id, negotiation, std::move(evaluator)));
   resource.connect("orchestrator", "CALL", "negotiator", "CALL");
+  resource.connect("orchestrator", "ASK", "negotiator", "ASK");
   resource.connect("negotiator", "AWARDED", "orchestrator", "AWARDED");
+  resource.connect("negotiator", "QUOTED", "orchestrator", "QUOTED");
   resource.connect("negotiator", "UNAVAILABLE", "orchestrator", "UNAVAILABLE");
   return orchestrator;
 }

@@ -3,6 +3,8 @@
 #include "services/node/restart_reason.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 
 #include "services/blocks/sample_checks.hpp"
 
@@ -38,10 +40,13 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
                                "waiting"});
   declare_input("RESOURCE_GONE", {"resource_id"});
   declare_input("AWARDED", {"call_id", "resource_id", "ahead"});
+  declare_input("QUOTED", {"call_id", "resource_id", "earliest_start", "duration"});
   declare_input("UNAVAILABLE", {"call_id", "reason"});
   declare_input("COMMAND_EVENT", {"command_id", "order_id", "state", "reason", "sim_time"});
   declare_input("SIM_REPLY", {"request_id", "ok", "error", "collided"});
   declare_output("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
+  declare_output("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
+  declare_output("QUOTE", {"station", "station_start", "robot", "robot_start", "fetch", "arm"});
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
@@ -49,7 +54,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_output("FINISHED", {"complete", "error", "take_up"});
 
   const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
-                              "HIRING", "PHYSICAL",     "CLEANUP", "ENDED"};
+                              "HIRING", "PHYSICAL",     "QUOTING", "CLEANUP", "ENDED"};
   // What the cell's resources say of themselves, in every state; a place that is no place
   // (a position that is not finite) is not taken.
   const auto is_place = [](const Data& d) {
@@ -108,10 +113,13 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   }
 
   // Booking a station, then hiring what physical assembly needs there.
-  for (const char* in : {"BOOKING", "QUEUED", "HIRING"}) {
-    transition(in, "AWARDED", in, [this](const Data& d) { on_awarded(d); });
+  for (const char* in : {"BOOKING", "QUEUED", "HIRING", "QUOTING"}) {
     transition(in, "UNAVAILABLE", in, [this](const Data& d) { fail(get<std::string>(d, "reason")); });
   }
+  for (const char* in : {"BOOKING", "QUEUED", "HIRING"}) {
+    transition(in, "AWARDED", in, [this](const Data& d) { on_awarded(d); });
+  }
+  transition("QUOTING", "QUOTED", "QUOTING", [this](const Data& d) { on_quoted(d); });
   for (const char* in : all_states) {
     transition(in, "RESOURCE_GONE", in, [this](const Data& d) { on_resource_gone(get<std::string>(d, "resource_id")); });
   }
@@ -171,7 +179,7 @@ void OrderOrchestrator::try_begin_virtual() {
   enter("VIRTUAL");
   status("VIRTUAL_ASSEMBLY", "virtual assembly in cell-sim", 0);
   step_ = candidate_ = 0;
-  if (plan_.steps.empty()) return book();
+  if (plan_.steps.empty()) return settings_.quote_only ? ask_for_quotes() : book();
   if (settings_.resume.attempt > 1) {
     // An earlier twin of the order may have died in the middle of it: its virtual bodies
     // are still in the order's scene (cell-sim keeps them for the order), in the way.
@@ -183,18 +191,43 @@ void OrderOrchestrator::try_begin_virtual() {
   next_action();
 }
 
-double OrderOrchestrator::physical_estimate() const {
-  const Numbers dock = places_.count(virtual_station_) ? places_.at(virtual_station_).dock : Numbers{0.6, 0, 0};
-  double length = 0;
+// A station's arm stands at the station's place; until its capability is heard, the speed
+// virtual assembly used.
+double OrderOrchestrator::arm_speed_at(const std::string& station) const {
+  const auto s = places_.find(station);
+  if (s == places_.end()) return settings_.arm_speed;
+  for (const auto& [id, p] : places_) {
+    if (p.kind == "arm" && p.speed > 0 && p.position == s->second.position) return p.speed;
+  }
+  return settings_.arm_speed;
+}
+
+std::vector<double> OrderOrchestrator::arm_times() const {
+  const std::string& station = station_.empty() ? virtual_station_ : station_;
+  const Numbers dock = places_.count(station) ? places_.at(station).dock : Numbers{0.6, 0, 0};
+  const double speed = arm_speed_at(station);
+  std::vector<double> out;
   for (const auto& step : plan_.steps) {
     const auto& w = step.trajectory.waypoints;
     std::vector<Pose> poses;
     for (const auto& p : w) poses.push_back(p.gripper);
     // From the dock to where the trajectory starts, along it, and back to the dock.
     const double to_start = (w.front().part.translation() - Vec3(dock[0], dock[1], dock[2])).norm();
-    length += 2 * to_start + path_length(poses);
+    out.push_back((2 * to_start + path_length(poses)) / speed);
   }
-  return length / settings_.arm_speed;
+  return out;
+}
+
+double OrderOrchestrator::physical_estimate() const {
+  const auto times = arm_times();
+  return std::accumulate(times.begin(), times.end(), 0.0);
+}
+
+Data OrderOrchestrator::call_data(const std::string& what, const std::string& operation, const std::string& type,
+                                  const std::string& station, const std::string& sources, long count,
+                                  double duration) const {
+  return {{"call_id", settings_.order_id + "/" + what}, {"operation", operation}, {"part_type", type},
+          {"station", station}, {"sources", sources}, {"count", std::int64_t(count)}, {"duration", duration}};
 }
 
 void OrderOrchestrator::book(std::string only) {
@@ -204,9 +237,7 @@ void OrderOrchestrator::book(std::string only) {
   waiting_since_ = std::chrono::steady_clock::now();
   const std::string why = only == settings_.resume.station ? ", where its parts stand" : ", whose queue is shorter";
   status("WAITING", only.empty() ? "virtual assembly done; booking a station" : "booking " + only + why, 0);
-  emit("CALL", {{"call_id", settings_.order_id + "/" + kHost}, {"operation", kHost}, {"part_type", std::string()},
-                {"station", only}, {"sources", std::string()}, {"count", std::int64_t(0)},
-                {"duration", physical_estimate()}});
+  emit("CALL", call_data(kHost, kHost, "", only, "", 0, physical_estimate()));
 }
 
 // Orders booked at the same moment see the same bids and may crowd one station: an order
@@ -258,15 +289,9 @@ std::map<std::string, int> OrderOrchestrator::parts_per_type() const {
 void OrderOrchestrator::hire() {
   enter("HIRING");
   status("WAITING", station_ + " is ours; hiring its arm, a mobile robot and buffers", 0);
-  const auto call = [this](const std::string& what, const std::string& operation, const std::string& type, long count,
-                           double duration) {
-    emit("CALL", {{"call_id", settings_.order_id + "/" + what}, {"operation", operation}, {"part_type", type},
-                  {"station", station_}, {"sources", std::string()}, {"count", std::int64_t(count)},
-                  {"duration", duration}});
-  };
-  call(kArm, "translate", "", 0, physical_estimate());
-  for (const auto& [type, count] : parts_per_type()) call(kGive + type, "give", type, count, 0);
-  hire_robot_when_ready();
+  emit("CALL", call_data(kArm, "translate", "", station_, "", 0, physical_estimate()));
+  for (const auto& [type, count] : parts_per_type()) emit("CALL", call_data(kGive + type, "give", type, station_, "", count, 0));
+  call_robot_when_ready("CALL");
 }
 
 void OrderOrchestrator::on_awarded(const Data& d) {
@@ -290,21 +315,77 @@ void OrderOrchestrator::on_awarded(const Data& d) {
     robot_ = resource;
   } else if (what.rfind(kGive, 0) == 0) {
     buffer_of_[what.substr(kGive.size())] = resource;
-    hire_robot_when_ready();
+    call_robot_when_ready("CALL");
   }
   start_physical_when_hired();
 }
 
 // The robot's bid depends on where it fetches from: it is called once every buffer is known.
-void OrderOrchestrator::hire_robot_when_ready() {
-  if (!robot_.empty() || buffer_of_.size() < parts_per_type().size()) return;
+void OrderOrchestrator::call_robot_when_ready(const char* how) {
+  if (robot_called_ || station_.empty() || buffer_of_.size() < parts_per_type().size()) return;
+  robot_called_ = true;
   std::vector<std::string> sources;
   for (const auto& step : plan_.steps) {
     sources.push_back(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
   }
-  emit("CALL", {{"call_id", settings_.order_id + "/" + kRobot}, {"operation", std::string("fetch")},
-                {"part_type", std::string()}, {"station", station_}, {"sources", fb::join_names(sources)},
-                {"count", std::int64_t(sources.size())}, {"duration", 0.0}});
+  emit(how, call_data(kRobot, "fetch", "", station_, fb::join_names(sources), static_cast<long>(sources.size()), 0));
+}
+
+// --- quotes --------------------------------------------------------------------------------
+
+void OrderOrchestrator::ask_for_quotes() {
+  enter("QUOTING");
+  status("WAITING", "virtual assembly done; asking the cell's resources for quotes", 0);
+  emit("ASK", call_data(kHost, kHost, "", "", "", 0, physical_estimate()));
+  for (const auto& [type, count] : parts_per_type()) emit("ASK", call_data(kGive + type, "give", type, "", "", count, 0));
+}
+
+void OrderOrchestrator::on_quoted(const Data& d) {
+  const std::string what = get<std::string>(d, "call_id").substr(settings_.order_id.size() + 1);
+  const std::string& resource = get<std::string>(d, "resource_id");
+  if (what == kHost) {
+    station_ = resource;
+    station_start_ = get<double>(d, "earliest_start");
+  } else if (what.rfind(kGive, 0) == 0) {
+    buffer_of_[what.substr(kGive.size())] = resource;
+  } else if (what == kRobot) {
+    robot_ = resource;
+    robot_start_ = get<double>(d, "earliest_start");
+    robot_duration_ = get<double>(d, "duration");
+    emit("QUOTE", {{"station", station_}, {"station_start", station_start_}, {"robot", robot_},
+                   {"robot_start", robot_start_}, {"fetch", fetch_times()}, {"arm", arm_times()}});
+    enter("ENDED");
+    return emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
+  }
+  call_robot_when_ready("ASK");
+}
+
+// The robot's bid is for the whole batch; each fetch gets its share by the distance it drives
+// (from where the robot stands to the buffer's dock, then to the station's), as the robot
+// itself estimates it. Places not known: equal shares.
+std::vector<double> OrderOrchestrator::fetch_times() const {
+  const auto dock = [this](const std::string& id) -> const Numbers* {
+    const auto it = places_.find(id);
+    return it == places_.end() || it->second.dock.size() < 3 ? nullptr : &it->second.dock;
+  };
+  const auto flat = [](const Numbers& a, const Numbers& b) { return std::hypot(a[0] - b[0], a[2] - b[2]); };
+  std::vector<double> distances;
+  const Numbers* to = dock(station_);
+  const auto robot = places_.find(robot_);
+  const Numbers* at = robot == places_.end() || robot->second.position.size() < 3 ? nullptr : &robot->second.position;
+  for (const auto& step : plan_.steps) {
+    const Numbers* from = dock(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
+    if (!to || !at || !from) break;
+    distances.push_back(flat(*at, *from) + flat(*from, *to));
+    at = to;
+  }
+  const double total = std::accumulate(distances.begin(), distances.end(), 0.0);
+  const std::size_t n = plan_.steps.size();
+  std::vector<double> out(n, n ? robot_duration_ / n : 0);
+  if (distances.size() == n && total > 0) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = robot_duration_ * distances[i] / total;
+  }
+  return out;
 }
 
 // Also once the places of the station and the buffers are known: a resource's proposal may
@@ -623,7 +704,7 @@ void OrderOrchestrator::next_action() {
       spawned_.clear();
       if (!actions_.empty()) return next_action();
     }
-    return book();
+    return settings_.quote_only ? ask_for_quotes() : book();
   }
   if (state() == "PHYSICAL") {
     status("PHYSICAL_ASSEMBLY", "physical assembly done", 1);
@@ -702,7 +783,9 @@ void OrderOrchestrator::finish() {
   for (const std::string& resource : awarded_) {
     emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", resource}});
   }
-  if (error_.empty()) {
+  if (settings_.quote_only) {
+    // Not feasible here is the quote's answer, which its caller gives.
+  } else if (error_.empty()) {
     status("DONE", "assembled " + std::to_string(plan_.steps.size()) + " parts at " + station_, 1);
   } else {
     status("FAILED", error_, 0);

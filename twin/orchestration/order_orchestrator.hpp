@@ -26,6 +26,11 @@
 //                inserts, releases, backs out, connects
 //   CLEANUP      the order's bodies leave cell-sim (the product leaves the station), then
 //   ENDED        everything released; FINISHED
+// An order for a quote (OrderSettings::quote_only) goes from VIRTUAL to
+//   QUOTING      calls for quotes (the Negotiator's ASK: bids, nothing awarded): a station,
+//                a buffer per part type, then a mobile robot for the batch; QUOTE with the
+//                best bids and the time each part and step takes, then ENDED; FINISHED. A
+//                call nobody bids on fails the order with every refusal's reason.
 // A failure anywhere cancels undelivered fetches and goes through CLEANUP to ENDED.
 //
 // No hold-and-wait: while it waits for a station the order holds nothing; once it holds a
@@ -34,9 +39,11 @@
 //
 //   inputs: START, TICK, CAPABILITY (resource_id, kind, position, dock, speed, angular_speed,
 //           reserved_by, waiting), RESOURCE_GONE (resource_id), AWARDED (call_id,
-//           resource_id, ahead), UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
+//           resource_id, ahead), QUOTED (call_id, resource_id, earliest_start, duration),
+//           UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
 //           order_id, state, reason, sim_time), SIM_REPLY (request_id, ok, error, collided, ...)
-//   outputs: CALL (to the Negotiator), RELEASE, COMMAND, CANCEL (fetches not delivered when
+//   outputs: CALL and ASK (to the Negotiator), QUOTE (station, station_start, robot,
+//            robot_start, fetch: s per part in planned order, arm: s per step), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: its body, assembled in place),
 //            FINISHED (complete, error, take_up: ended for the next twin to take the order up)
@@ -81,6 +88,9 @@ struct OrderSettings {
   // this twin at once, releasing nothing, so that the next twin the cell starts takes the
   // order up from the cell's state. Off: the order fails.
   bool take_up_after_restart = false;
+  // Plan and assemble virtually, then ask for quotes instead of booking: no station, no
+  // stock, nothing physical. The final status is the caller's (it prices the quote).
+  bool quote_only = false;
 };
 
 class OrderOrchestrator : public fb::BasicBlock {
@@ -96,6 +106,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   const Timeline& timeline() const { return timeline_; }
   // Arm time of physical assembly: how long the order will hold a station, s of sim time.
   double physical_estimate() const;
+  std::vector<double> arm_times() const;  // the same, per step
 
  private:
   struct Action {
@@ -121,7 +132,14 @@ class OrderOrchestrator : public fb::BasicBlock {
   void on_resource_gone(const std::string& id);
   void hire();
   void on_awarded(const fb::Data& award);
-  void hire_robot_when_ready();
+  void call_robot_when_ready(const char* how);  // CALL or ASK
+  double arm_speed_at(const std::string& station) const;
+  // Quotes.
+  void ask_for_quotes();
+  void on_quoted(const fb::Data& quote);
+  std::vector<double> fetch_times() const;  // s per part in planned order: the robot's bid, shared by distance
+  fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
+                     const std::string& station, const std::string& sources, long count, double duration) const;
   void start_physical_when_hired();
   // Scripts.
   void add_candidate(std::size_t step, std::size_t candidate);
@@ -170,6 +188,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::map<std::string, std::string> award_of_;   // resource -> the call it was awarded (commands name it)
   long ahead_ = -1;                               // in the station's queue, as last reported
   bool arm_held_ = false;
+  bool robot_called_ = false;
+  double station_start_ = 0, robot_start_ = 0, robot_duration_ = 0;  // quotes: the best bids
   std::set<std::string> delivered_, spawned_;
   struct Sent {
     fb::Data command;

@@ -3,9 +3,12 @@
 // cell-sim, physical assembly. Publishes its status while it lives (a twin that dies is
 // noticed by the resources it reserved) and writes the plan and the animation.
 //   twin --domain 42 --order o1 --product deploy/products/cranfield/cranfield.aml --out out/o1
-// Exit codes: 0 assembled, 1 the order failed, 2 bad input.
+// With --quote it assembles virtually only and writes quote.json (docs/quotes.md).
+// Exit codes: 0 assembled (or quoted, feasible or not), 1 the order failed, 2 bad input.
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <atomic>
 #include <thread>
 #include <csignal>
@@ -29,6 +32,7 @@
 #include "twin/geometry/product_loader.hpp"
 #include "twin/model/source_ref.hpp"
 #include "twin/orchestration/order_network.hpp"
+#include "twin/orchestration/quote.hpp"
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/html_report.hpp"
 #include "twin/report/plan_json.hpp"
@@ -59,6 +63,8 @@ struct Options {
   fb::GripperGeometry gripper;
   bool verbose = false;
   bool quiet = false;
+  bool quote = false;
+  twin::Rates rates;
 };
 
 class TwinProcess {
@@ -126,6 +132,7 @@ class TwinProcess {
     if (!plan.complete) {
       write_plan(product, plan, plan_file);
       std::string why = plan.findings.empty() ? "no complete plan" : plan.findings.back().message;
+      if (options_.quote) return end_quote(twin::infeasible_quote("planning found no complete assembly: " + why, options_.rates), plan);
       return end_with(1, "planning found no complete assembly: " + why, plan_file.string());
     }
     if (!plan.subassemblies.empty()) {
@@ -134,6 +141,10 @@ class TwinProcess {
       write_plan(product, plan, plan_file);
       std::string names;
       for (const auto& s : plan.subassemblies) names += (names.empty() ? "" : ", ") + s.name;
+      if (options_.quote) {
+        return end_quote(twin::infeasible_quote("the plan builds subassemblies (" + names + "), which this cell does not assemble yet",
+                                                options_.rates), plan);
+      }
       return end_with(1, "the plan builds subassemblies (" + names + "), which this cell does not assemble yet; see the plan",
                       plan_file.string());
     }
@@ -157,6 +168,22 @@ class TwinProcess {
     std::cerr << "error: order " << options_.order << ": " << error << '\n';
     linger();
     return code;
+  }
+
+  // A quote is the order's answer, feasible or not: quote.json beside plan.json, and DONE.
+  int end_quote(const twin::Quote& quote, const twin::Plan& plan) {
+    std::ofstream(std::filesystem::path(options_.out) / "quote.json")
+        << twin::quote_json(options_.order, quote, plan.steps.size(), plan.findings).dump(2) << '\n';
+    char summary[160];
+    if (quote.feasible) {
+      std::snprintf(summary, sizeof summary, "quoted: done in %.0f s (%.0f s waiting for %s), %.2f %s", quote.makespan_s,
+                    quote.wait_s, quote.station.c_str(), quote.total_cost, quote.currency.c_str());
+    }
+    status("DONE", quote.feasible ? summary : "quoted: not feasible: " + quote.reason, 1);
+    result(true, (std::filesystem::path(options_.out) / "plan.json").string(), "", "");
+    if (store_) store_->set_order(options_.order, "DONE", "", 0);
+    linger();
+    return 0;
   }
 
   // Where an earlier twin of the order left it (the cell's state): once the work it had
@@ -241,6 +268,7 @@ class TwinProcess {
     settings.take_up_after_restart = store_ && store_->awaits_twin(options_.order);
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
     settings.gripper = options_.gripper;
+    settings.quote_only = options_.quote;
     fb::NegotiationSettings negotiation;
     negotiation.wait = settings.wait_timeout;
     auto& orchestrator = twin::add_order_network(r, product, plan, settings, negotiation);
@@ -318,6 +346,14 @@ class TwinProcess {
       if (store_) store_->place(options_.order, fb::get<std::string>(d, "part"));
     }));
     r.connect("orchestrator", "PLACED", "placed", "REQ");
+    std::optional<twin::Quote> quote;
+    r.add(std::make_unique<fb::ActionBlock>("quote", [this, &quote](const fb::Data& d) {
+      twin::QuoteBids bids{fb::get<std::string>(d, "station"), fb::get<std::string>(d, "robot"),
+                           fb::get<double>(d, "station_start"), fb::get<double>(d, "robot_start"),
+                           fb::get<fb::Numbers>(d, "fetch"), fb::get<fb::Numbers>(d, "arm")};
+      quote = twin::estimate_quote(bids, clock_.now(), options_.rates);
+    }));
+    r.connect("orchestrator", "QUOTE", "quote", "REQ");
     bool finished = false;
     r.add(std::make_unique<fb::ActionBlock>("finished", [&finished](const fb::Data&) { finished = true; }));
     r.connect("orchestrator", "FINISHED", "finished", "REQ");
@@ -357,6 +393,9 @@ class TwinProcess {
     twin::AnimationOptions look;
     look.gripper = options_.gripper;
     twin::write_gltf_animation(product, validated, animation, look);
+    if (options_.quote) {
+      return watchdog.exit(end_quote(quote ? *quote : twin::infeasible_quote(orchestrator.error(), options_.rates), validated));
+    }
     if (!orchestrator.error().empty()) return watchdog.exit(end_with(1, orchestrator.error(), plan_file.string(), true));
     result(true, plan_file.string(), animation.string(), "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);
@@ -391,9 +430,27 @@ int main(int argc, char** argv) {
   app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
   dds::add_state_option(app, o.state_dir);
   dds::add_gripper_options(app, o.gripper);
+  app.add_flag("--quote", o.quote, "Assemble virtually only and answer with quote.json: time and cost here, findings");
+  app.add_option("--setup-cost", o.rates.setup_cost, "Quote: the fixed cost of an order")->check(CLI::NonNegativeNumber);
+  std::vector<std::string> rates;
+  app.add_option("--cost-per-hour", rates, "Quote: RESOURCE=COST, for each hour the order uses the resource");
+  app.add_option("--currency", o.rates.currency, "Quote: the currency of the costs");
   app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
   app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
   CLI11_PARSE(app, argc, argv);
+  for (const auto& r : rates) {
+    const auto eq = r.find('=');
+    double cost = -1;
+    try {
+      if (eq != std::string::npos && eq > 0) cost = std::stod(r.substr(eq + 1));
+    } catch (const std::exception&) {
+    }
+    if (!(cost >= 0 && std::isfinite(cost))) {
+      std::cerr << "error: --cost-per-hour " << r << ": give RESOURCE=COST, a number >= 0\n";
+      return 2;
+    }
+    o.rates.per_hour[r.substr(0, eq)] = cost;
+  }
   dds::apply_interfaces(o.dds, all_interfaces);
   if (o.dds.security.identity.empty()) o.dds.security.identity = "twin";  // every twin has the role's identity
   std::signal(SIGINT, stop);
