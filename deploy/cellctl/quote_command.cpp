@@ -37,7 +37,8 @@ struct Asked {
   CellConfig cell;
   RemoteSubmission submission;
   int exit_code = -1;
-  json quote;  // its quote.json; null: none came
+  std::string error;  // why it did not answer
+  json quote;         // its quote.json; null: none came
 };
 
 // A quote.json as a cell wrote it: checked before it is shown (it came over the network).
@@ -100,7 +101,7 @@ int run_quotes(const QuoteOptions& o) {
     for (auto& a : asked) {
       threads.emplace_back([&a] {
         try {
-          a->exit_code = submit_remote(a->submission, stop_quoting);
+          a->exit_code = submit_remote(a->submission, stop_quoting, &a->error);
         } catch (const std::exception& e) {
           std::cerr << "[" << a->name << "] error: " << e.what() << '\n';
           a->exit_code = 1;
@@ -117,7 +118,7 @@ int run_quotes(const QuoteOptions& o) {
   for (auto& a : asked) {
     std::string why;
     if (a->exit_code == 0) a->quote = read_quote(fs::path(a->submission.out) / "quote.json", why);
-    else why = a->exit_code == 3 ? "no answer from its order desk" : "its desk refused or failed the request (exit " + std::to_string(a->exit_code) + ")";
+    else why = a->error.empty() ? "its desk ended the request with exit " + std::to_string(a->exit_code) : a->error;
     json entry = {{"cell", a->name}, {"file", fs::absolute(a->cell.file).string()}, {"domain", a->cell.domain},
                   {"results", a->submission.out}};
     if (a->quote.is_null()) {

@@ -57,7 +57,11 @@ struct Inbox {
 
 }  // namespace
 
-int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
+int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop, std::string* error) {
+  const auto fail = [&](const std::string& why) {
+    say(s, std::cerr, "error: " + why);
+    if (error) *error = why;
+  };
   const auto files = files_of(s.product);
   const std::string product_name = fs::path(s.product).filename().string();
   // Replies are kept per submission id for late readers: this request's carry its id.
@@ -93,7 +97,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     return std::chrono::duration_cast<std::chrono::milliseconds>(answer_by - std::chrono::steady_clock::now());
   };
   if (!chunks.wait_for_readers(1, left()) || !orders.wait_for_readers(1, left())) {
-    say(s, std::cerr, "error: no order desk for client " + s.client + " answered on domain " + std::to_string(s.dds.domain_id) +
+    fail("no order desk for client " + s.client + " answered on domain " + std::to_string(s.dds.domain_id) +
                           " within " + std::to_string(s.wait.count()) +
                           " s (is the client in the cell's `clients:`, and its identity the cell's?)");
     return 3;
@@ -108,7 +112,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
   const auto upload_by = std::chrono::steady_clock::now() + 10 * s.wait;  // the desk takes chunks at its pace
   for (const auto& [name, data] : files) {
     if (!send_file(chunks, s.submission, name, data, upload_by)) {
-      say(s, std::cerr, "error: the desk took no more of " + name);
+      fail("the desk took no more of " + name);
       return 3;
     }
     cell::FileDigest d;
@@ -121,7 +125,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
   // The order on its own topic must not overtake the last chunks on theirs.
   if (!chunks.wait_for_acknowledgments(std::chrono::duration_cast<std::chrono::milliseconds>(upload_by - std::chrono::steady_clock::now())) ||
       !orders.write(request)) {
-    say(s, std::cerr, "error: the desk did not take the order's files");
+    fail("the desk did not take the order's files");
     return 3;
   }
   say(s, std::cout, "sent " + std::to_string(files.size()) + " files (" + std::to_string(bytes) + " bytes) of " + product_name +
@@ -139,7 +143,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
       last_heard = std::chrono::steady_clock::now();
       switch (r.state()) {
         case cell::DESK_REFUSED:
-          say(s, std::cerr, "error: the desk refused the order: " + r.message().to_string());
+          fail("the desk refused the order: " + r.message().to_string());
           return r.exit_code();
         case cell::DESK_ACCEPTED:
           say(s, std::cout, r.message().to_string());
@@ -157,7 +161,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
       }
     }
     if (!inbox.results_error.empty()) {
-      say(s, std::cerr, "error: the results came broken: " + inbox.results_error);
+      fail("the results came broken: " + inbox.results_error);
       return 1;
     }
     if (end && inbox.results.complete_files() >= end->result_files()) break;
@@ -165,7 +169,7 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     // long, a step not 5 minutes); results within --wait of the end.
     const auto silence = accepted && !end ? std::max<std::chrono::seconds>(s.wait, 300s) : s.wait;
     if (std::chrono::steady_clock::now() - last_heard > silence) {
-      say(s, std::cerr, std::string("error: the desk went silent") + (end ? " before all results came" : ""));
+      fail(std::string("the desk went silent") + (end ? " before all results came" : ""));
       return 3;
     }
   }
@@ -178,12 +182,12 @@ int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop) {
     const fs::path file = fs::path(s.out) / fs::path(name).filename();
     std::ofstream out(file, std::ios::binary);
     if (!(out << data).flush()) {
-      say(s, std::cerr, "error: cannot write " + file.string());
+      fail("cannot write " + file.string());
       return 1;
     }
   }
   if (end->state() != cell::DESK_DONE) {
-    say(s, std::cerr, "error: order " + end->order_id().to_string() + ": " + end->message().to_string());
+    fail("order " + end->order_id().to_string() + ": " + end->message().to_string());
   } else if (s.quote) {
     say(s, std::cout, "quote " + end->order_id().to_string() + ": " + s.out + "/quote.json, " + s.out + "/report.html");
   } else {

@@ -20,7 +20,7 @@ struct RemoteSubmission {
 };
 
 // Its exit code: the order's (0 assembled, 1 failed, 2 a bad description), that of a refusal
-// (2 bad input, 1 a limit of the desk), or 3 when no desk answered.
-int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop);
+// (2 bad input, 1 a limit of the desk), or 3 when no desk answered. `error`: what went wrong.
+int submit_remote(const RemoteSubmission& s, const std::atomic<bool>& stop, std::string* error = nullptr);
 
 }  // namespace cellctl

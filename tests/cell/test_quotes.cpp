@@ -78,7 +78,10 @@ TEST_CASE("quotes: two cells answer with time, cost and findings, the best by ti
     CHECK(log.find("fast     yes") != std::string::npos);
     CHECK(log.find("time\n") != std::string::npos);
     CHECK(log.find("cost\n") != std::string::npos);
-    CHECK(fs::file_size(dir / "cranfield" / "thrifty" / "report.html") > 100000);
+    // The report says the answer at its top.
+    CHECK(test::read_text(dir / "cranfield" / "thrifty" / "report.html").find("<p class=\"answer\">quoted: done in") !=
+          std::string::npos);
+    CHECK(fs::file_size(dir / "cranfield" / "thrifty" / "animation.gltf") > 1000);
     CHECK(read_json(dir / "cranfield" / "fast" / "quote.json")["order"].get<std::string>().rfind("oem-a-quote-cranfield-", 0) == 0);
   }
 
@@ -92,6 +95,8 @@ TEST_CASE("quotes: two cells answer with time, cost and findings, the best by ti
     CHECK(t["feasible"] == false);
     CHECK(t["reason"].get<std::string>().find("nobody offered give Brick2x2") != std::string::npos);
     CHECK(test::read_text(dir / "lego.log").find("thrifty  no") != std::string::npos);
+    CHECK(test::read_text(dir / "lego" / "thrifty" / "report.html").find("quoted: not feasible: nobody offered give Brick2x2") !=
+          std::string::npos);
   }
 
   CHECK(test::cellctl({"down", "--domain", "228"}, dir / "down-fast.log", 30s) == 0);

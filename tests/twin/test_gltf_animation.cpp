@@ -9,11 +9,9 @@
 #include "twin/report/gltf_animation.hpp"
 
 TEST_CASE("the virtual assembly is written as a glTF 2.0 animation", "[gltf]") {
-  sim::MeshCache cache;
-  const auto loaded = twin::load_product(test::product("cranfield/cranfield.aml"), cache);
-  auto sequence = twin::make_sequence_planner("search");
-  auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path);
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
+  const twin::LoadedProduct& loaded = cranfield.product;
+  const twin::Plan& plan = cranfield.plan;
   REQUIRE(plan.complete);
   const auto file = std::filesystem::temp_directory_path() / ("cranfield-" + std::to_string(::getpid()) + ".gltf");
   twin::write_gltf_animation(loaded, plan, file);

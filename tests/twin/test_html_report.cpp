@@ -16,11 +16,9 @@ std::size_t count(const std::string& text, const std::string& what) {
 
 TEST_CASE("the report is one page with the viewer built in, every finding, the margins and the cell's run",
           "[report]") {
-  sim::MeshCache cache;
-  const auto loaded = twin::load_product(test::product("cranfield/cranfield.aml"), cache);
-  auto sequence = twin::make_sequence_planner("search");
-  auto path = twin::make_path_planner("linear");
-  const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path);
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
+  const twin::LoadedProduct& loaded = cranfield.product;
+  const twin::Plan& plan = cranfield.plan;
   REQUIRE(plan.complete);
 
   const std::string page = twin::html_report(loaded, plan);

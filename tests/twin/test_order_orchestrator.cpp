@@ -8,7 +8,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "twin/geometry/product_loader.hpp"
+#include "tests/twin/test_support.hpp"
 #include "twin/orchestration/order_network.hpp"
 
 namespace {
@@ -163,19 +163,6 @@ Outcome run(Twin& t, const Cell& cell) {
   return out;
 }
 
-// A product from deploy/products, planned (search, linear) as the twin plans it.
-struct Planned {
-  explicit Planned(const std::string& product_file)
-      : product(twin::load_product(std::string(PRODUCTS_DIR) + "/" + product_file, meshes)), plan(plan_of(product)) {}
-  static twin::Plan plan_of(const twin::LoadedProduct& product) {
-    twin::SearchSequencePlanner sequence;
-    return twin::plan_assembly(product, sequence, *twin::make_path_planner("linear"));
-  }
-  sim::MeshCache meshes;
-  twin::LoadedProduct product;
-  twin::Plan plan;
-};
-
 bool carries(const Data& move, const std::string& body) {
   const auto carried = fb::split_names(get<std::string>(move, "carried"));
   return std::find(carried.begin(), carried.end(), body) != carried.end();
@@ -185,7 +172,7 @@ bool carries(const Data& move, const std::string& body) {
 
 TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holding nothing, then a station",
           "[twin][orchestration]") {
-  const Planned cranfield("cranfield/cranfield.aml");
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
   Twin t(cranfield.product, cranfield.plan);
   const Outcome out = run(t, Cell{});
   INFO(out.error);
@@ -219,7 +206,7 @@ TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holdin
 }
 
 TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on when the station is its", "[twin][orchestration]") {
-  const Planned lego("lego-tower/lego-tower.aml");
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
   Twin t(lego.product, lego.plan);
   Cell cell;
   cell.ahead = 3;
@@ -230,7 +217,7 @@ TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on whe
 }
 
 TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequence planning", "[twin][orchestration]") {
-  const Planned cranfield("cranfield/cranfield.aml");
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
   const twin::Plan& plan = cranfield.plan;
   REQUIRE(plan.complete);
   const std::string second = "o1/virtual/" + cranfield.product.product.parts()[plan.steps[1].part].name;
@@ -255,7 +242,7 @@ TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequenc
 }
 
 TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, with the reason", "[twin][orchestration]") {
-  const Planned lego("lego-tower/lego-tower.aml");
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
   Twin t(lego.product, lego.plan);
   Cell cell;
   cell.collide = [](const Data& move, long) { return carries(move, "o1/virtual/hanging"); };
@@ -268,7 +255,7 @@ TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, w
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {
-  const Planned lego("lego-tower/lego-tower.aml");
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
   Twin t(lego.product, lego.plan);
   // The robot delivers the first two parts; the arm cannot grip the second.
   int fetches = 0, grips = 0;
@@ -293,7 +280,7 @@ TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not 
 }
 
 TEST_CASE("orchestrator: an order for a quote assembles virtually, asks for bids, and takes nothing", "[twin][orchestration][quote]") {
-  const Planned cranfield("cranfield/cranfield.aml");
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
   Twin t(cranfield.product, cranfield.plan, true);
   const Outcome out = run(t, Cell{});
   INFO(out.error);
@@ -319,7 +306,7 @@ TEST_CASE("orchestrator: an order for a quote assembles virtually, asks for bids
 }
 
 TEST_CASE("orchestrator: a quote nobody can bid on ends with every refusal's reason", "[twin][orchestration][quote]") {
-  const Planned lego("lego-tower/lego-tower.aml");
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
   Twin t(lego.product, lego.plan, true);
   Cell cell;
   cell.refuse_call = [](const Data& call) {

@@ -8,6 +8,9 @@
 
 #include "sim/mesh/triangle_mesh.hpp"
 #include "twin/geometry/product_loader.hpp"
+#include "twin/planning/assembly_planner.hpp"
+#include "twin/planning/path_planner.hpp"
+#include "twin/planning/sequence_planner.hpp"
 
 namespace test {
 
@@ -18,6 +21,19 @@ inline twin::LoadedProduct load(const std::filesystem::path& file) {
   sim::MeshCache cache;
   return twin::load_product(file, cache);
 }
+
+// A product loaded and planned as the twin plans it (search, linear); the mesh cache lives
+// as long as the product that points into it.
+struct Planned {
+  explicit Planned(const std::filesystem::path& file) : product(twin::load_product(file, meshes)), plan(plan_of(product)) {}
+  static twin::Plan plan_of(const twin::LoadedProduct& product) {
+    auto sequence = twin::make_sequence_planner("search");
+    return twin::plan_assembly(product, *sequence, *twin::make_path_planner("linear"));
+  }
+  sim::MeshCache meshes;
+  twin::LoadedProduct product;
+  twin::Plan plan;
+};
 
 inline const twin::DigitalPart& part(const twin::Product& product, const std::string& name) {
   const auto index = product.find_part_by_name(name);

@@ -75,6 +75,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       if (state() == "QUEUED" && p.kind == "station" && id != station_) consider_moving_to(id);
       if (state() == "HIRING" && id == arm_ && p.reserved_by == settings_.order_id) arm_held_ = true;
       if (state() == "HIRING") start_physical_when_hired();
+      if (state() == "QUOTING") quote_when_arm_known();
     });
   }
 
@@ -120,6 +121,9 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     transition(in, "AWARDED", in, [this](const Data& d) { on_awarded(d); });
   }
   transition("QUOTING", "QUOTED", "QUOTING", [this](const Data& d) { on_quoted(d); });
+  transition("QUOTING", "TICK", "QUOTING", [this](const Data&) {
+    if (!robot_.empty() && waited_too_long()) fail("the arm of " + station_ + " did not say its speed (no capability heard)");
+  });
   for (const char* in : all_states) {
     transition(in, "RESOURCE_GONE", in, [this](const Data& d) { on_resource_gone(get<std::string>(d, "resource_id")); });
   }
@@ -193,19 +197,20 @@ void OrderOrchestrator::try_begin_virtual() {
 
 // A station's arm stands at the station's place; until its capability is heard, the speed
 // virtual assembly used.
-double OrderOrchestrator::arm_speed_at(const std::string& station) const {
+const OrderOrchestrator::Place* OrderOrchestrator::arm_at(const std::string& station) const {
   const auto s = places_.find(station);
-  if (s == places_.end()) return settings_.arm_speed;
+  if (s == places_.end()) return nullptr;
   for (const auto& [id, p] : places_) {
-    if (p.kind == "arm" && p.speed > 0 && p.position == s->second.position) return p.speed;
+    if (p.kind == "arm" && p.speed > 0 && p.position == s->second.position) return &p;
   }
-  return settings_.arm_speed;
+  return nullptr;
 }
 
 std::vector<double> OrderOrchestrator::arm_times() const {
   const std::string& station = station_.empty() ? virtual_station_ : station_;
   const Numbers dock = places_.count(station) ? places_.at(station).dock : Numbers{0.6, 0, 0};
-  const double speed = arm_speed_at(station);
+  const Place* arm = arm_at(station);
+  const double speed = arm ? arm->speed : settings_.arm_speed;
   std::vector<double> out;
   for (const auto& step : plan_.steps) {
     const auto& w = step.trajectory.waypoints;
@@ -335,6 +340,7 @@ void OrderOrchestrator::call_robot_when_ready(const char* how) {
 
 void OrderOrchestrator::ask_for_quotes() {
   enter("QUOTING");
+  waiting_since_ = std::chrono::steady_clock::now();
   status("WAITING", "virtual assembly done; asking the cell's resources for quotes", 0);
   emit("ASK", call_data(kHost, kHost, "", "", "", 0, physical_estimate()));
   for (const auto& [type, count] : parts_per_type()) emit("ASK", call_data(kGive + type, "give", type, "", "", count, 0));
@@ -352,12 +358,18 @@ void OrderOrchestrator::on_quoted(const Data& d) {
     robot_ = resource;
     robot_start_ = get<double>(d, "earliest_start");
     robot_duration_ = get<double>(d, "duration");
-    emit("QUOTE", {{"station", station_}, {"station_start", station_start_}, {"robot", robot_},
-                   {"robot_start", robot_start_}, {"fetch", fetch_times()}, {"arm", arm_times()}});
-    enter("ENDED");
-    return emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
+    return quote_when_arm_known();
   }
   call_robot_when_ready("ASK");
+}
+
+// The arm's times need its speed: its capability may come later than the station's.
+void OrderOrchestrator::quote_when_arm_known() {
+  if (robot_.empty() || !arm_at(station_)) return;
+  emit("QUOTE", {{"station", station_}, {"station_start", station_start_}, {"robot", robot_},
+                 {"robot_start", robot_start_}, {"fetch", fetch_times()}, {"arm", arm_times()}});
+  enter("ENDED");
+  emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
 }
 
 // The robot's bid is for the whole batch; each fetch gets its share by the distance it drives

@@ -28,8 +28,9 @@
 //   ENDED        everything released; FINISHED
 // An order for a quote (OrderSettings::quote_only) goes from VIRTUAL to
 //   QUOTING      calls for quotes (the Negotiator's ASK: bids, nothing awarded): a station,
-//                a buffer per part type, then a mobile robot for the batch; QUOTE with the
-//                best bids and the time each part and step takes, then ENDED; FINISHED. A
+//                a buffer per part type, then a mobile robot for the batch; once the
+//                station's arm has said its speed, QUOTE with the best bids and the time
+//                each part and step takes, then ENDED; FINISHED. A
 //                call nobody bids on fails the order with every refusal's reason.
 // A failure anywhere cancels undelivered fetches and goes through CLEANUP to ENDED.
 //
@@ -133,10 +134,11 @@ class OrderOrchestrator : public fb::BasicBlock {
   void hire();
   void on_awarded(const fb::Data& award);
   void call_robot_when_ready(const char* how);  // CALL or ASK
-  double arm_speed_at(const std::string& station) const;
+  const Place* arm_at(const std::string& station) const;  // its arm, once its capability is heard
   // Quotes.
   void ask_for_quotes();
   void on_quoted(const fb::Data& quote);
+  void quote_when_arm_known();
   std::vector<double> fetch_times() const;  // s per part in planned order: the robot's bid, shared by distance
   fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
                      const std::string& station, const std::string& sources, long count, double duration) const;

@@ -130,23 +130,21 @@ class TwinProcess {
     std::filesystem::create_directories(options_.out);
     const auto plan_file = std::filesystem::absolute(options_.out) / "plan.json";
     if (!plan.complete) {
+      std::string why = "planning found no complete assembly: " +
+                        (plan.findings.empty() ? std::string("no complete plan") : plan.findings.back().message);
+      if (options_.quote) return end_quote(product, twin::infeasible_quote(why, options_.rates), plan);
       write_plan(product, plan, plan_file);
-      std::string why = plan.findings.empty() ? "no complete plan" : plan.findings.back().message;
-      if (options_.quote) return end_quote(twin::infeasible_quote("planning found no complete assembly: " + why, options_.rates), plan);
-      return end_with(1, "planning found no complete assembly: " + why, plan_file.string());
+      return end_with(1, why, plan_file.string());
     }
     if (!plan.subassemblies.empty()) {
       // Building one aside and inserting it whole needs cell-sim and the arm to carry several
       // parts as one body: not there yet. The designer still gets the plan.
-      write_plan(product, plan, plan_file);
       std::string names;
       for (const auto& s : plan.subassemblies) names += (names.empty() ? "" : ", ") + s.name;
-      if (options_.quote) {
-        return end_quote(twin::infeasible_quote("the plan builds subassemblies (" + names + "), which this cell does not assemble yet",
-                                                options_.rates), plan);
-      }
-      return end_with(1, "the plan builds subassemblies (" + names + "), which this cell does not assemble yet; see the plan",
-                      plan_file.string());
+      const std::string why = "the plan builds subassemblies (" + names + "), which this cell does not assemble yet";
+      if (options_.quote) return end_quote(product, twin::infeasible_quote(why, options_.rates), plan);
+      write_plan(product, plan, plan_file);
+      return end_with(1, why + "; see the plan", plan_file.string());
     }
     return orchestrate(product, plan, plan_file);
   }
@@ -170,17 +168,24 @@ class TwinProcess {
     return code;
   }
 
-  // A quote is the order's answer, feasible or not: quote.json beside plan.json, and DONE.
-  int end_quote(const twin::Quote& quote, const twin::Plan& plan) {
-    std::ofstream(std::filesystem::path(options_.out) / "quote.json")
-        << twin::quote_json(options_.order, quote, plan.steps.size(), plan.findings).dump(2) << '\n';
-    char summary[160];
+  // A quote is the order's answer, feasible or not: quote.json beside plan.json and the
+  // report (which says it at the top), and DONE.
+  int end_quote(const twin::LoadedProduct& product, const twin::Quote& quote, const twin::Plan& plan) {
+    const std::filesystem::path out(options_.out);
+    std::ofstream(out / "quote.json") << twin::quote_json(options_.order, quote, plan.steps.size(), plan.findings).dump(2) << '\n';
+    std::string summary = "quoted: not feasible: " + quote.reason;
     if (quote.feasible) {
-      std::snprintf(summary, sizeof summary, "quoted: done in %.0f s (%.0f s waiting for %s), %.2f %s", quote.makespan_s,
+      char text[200];
+      std::snprintf(text, sizeof text, "quoted: done in %.0f s (%.0f s waiting for %s), %.2f %s", quote.makespan_s,
                     quote.wait_s, quote.station.c_str(), quote.total_cost, quote.currency.c_str());
+      summary = text;
     }
-    status("DONE", quote.feasible ? summary : "quoted: not feasible: " + quote.reason, 1);
-    result(true, (std::filesystem::path(options_.out) / "plan.json").string(), "", "");
+    write_plan(product, plan, out / "plan.json", {}, summary);
+    twin::AnimationOptions look;
+    look.gripper = options_.gripper;
+    twin::write_gltf_animation(product, plan, out / "animation.gltf", look);
+    status("DONE", summary, 1);
+    result(true, (out / "plan.json").string(), "", "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);
     linger();
     return 0;
@@ -232,12 +237,13 @@ class TwinProcess {
 
   // plan.json and, beside it, the designer's report.html (with the cell's run, once there is one).
   void write_plan(const twin::LoadedProduct& product, const twin::Plan& plan, const std::filesystem::path& file,
-                  const twin::Timeline& timeline = {}) const {
+                  const twin::Timeline& timeline = {}, const std::string& answer = "") const {
     std::ofstream(file) << twin::plan_json(product.product, plan).dump(2) << '\n';
     twin::ReportOptions report;
     report.look.gripper = options_.gripper;
     report.title = options_.order;
     report.timeline = timeline;
+    report.answer = answer;
     twin::write_html_report(product, plan, file.parent_path() / "report.html", report);
   }
 
@@ -388,14 +394,15 @@ class TwinProcess {
     // made it go back), planning's and virtual assembly's findings, and the animation.
     twin::Plan validated = orchestrator.plan();
     validated.findings.insert(validated.findings.end(), findings.begin(), findings.end());
+    if (options_.quote) {
+      const auto why = twin::infeasible_quote(orchestrator.error(), options_.rates);
+      return watchdog.exit(end_quote(product, quote ? *quote : why, validated));
+    }
     write_plan(product, validated, plan_file, orchestrator.timeline());
     const auto animation = plan_file.parent_path() / "animation.gltf";
     twin::AnimationOptions look;
     look.gripper = options_.gripper;
     twin::write_gltf_animation(product, validated, animation, look);
-    if (options_.quote) {
-      return watchdog.exit(end_quote(quote ? *quote : twin::infeasible_quote(orchestrator.error(), options_.rates), validated));
-    }
     if (!orchestrator.error().empty()) return watchdog.exit(end_with(1, orchestrator.error(), plan_file.string(), true));
     result(true, plan_file.string(), animation.string(), "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);

@@ -14,10 +14,6 @@
 namespace twin {
 namespace {
 
-// Objective::margin: an order is better only by more than this. Without it, orders whose least
-// margins differ by the mesh's rounding (Cranfield's 0.4976 and 0.5000 mm) are all searched.
-constexpr double kMarginResolution = 5e-5;  // m
-
 std::string millimetres(double metres) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.2f mm", metres * 1000);

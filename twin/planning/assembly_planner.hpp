@@ -75,6 +75,11 @@ struct PlannerOptions {
   double margin_reach = 0.010;      // m: margins are measured up to this; 0: not measured
 };
 
+// Margins closer than this are taken as equal, m: Objective::margin takes an order as better
+// only by more than this, and so do the suggestions. Without it, orders whose least margins
+// differ by the mesh's rounding (Cranfield's 0.4976 and 0.5000 mm) are all searched.
+constexpr double kMarginResolution = 5e-5;
+
 // The least margin of the steps (the reach where none came nearer).
 double least_margin(const std::vector<PlanStep>& steps, double reach);
 

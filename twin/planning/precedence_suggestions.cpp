@@ -8,7 +8,6 @@
 namespace twin {
 namespace {
 
-constexpr double kMarginResolution = 5e-5;  // m: as the margin search's (assembly_planner.cpp)
 // Each alternative is searched this far: a part that cannot come next is most often shown so
 // by an exhaustive search, which on Cranfield took a minute for all its alternatives.
 constexpr std::size_t kMaxBacktracks = 300;

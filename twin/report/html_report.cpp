@@ -210,7 +210,9 @@ std::string html_report(const LoadedProduct& loaded, const Plan& plan, const Rep
        << " parts in " << plan.steps.size() << " steps; sequence " << escape(plan.sequence_planner) << ", path "
        << escape(plan.path_planner) << "; " << plan.backtracks << " backtracks; least insertion margin "
        << fixed(least_margin(plan.steps, plan.margin_reach) * 1000, 2) << " mm; " << plan.findings.size()
-       << " findings.</p></header>\n<main>\n"
+       << " findings.</p>\n"
+       << (options.answer.empty() ? "" : "<p class=\"answer\">" + escape(options.answer) + "</p>\n")
+       << "</header>\n<main>\n"
        << "<section id=\"viewer\"><div id=\"stage\"><canvas id=\"view\" width=\"960\" height=\"540\"></canvas>"
           "<div id=\"caption\"></div><div id=\"viewer-error\" hidden></div></div>\n"
           "<div id=\"controls\"><button id=\"play\" type=\"button\">Pause</button> "

@@ -17,6 +17,7 @@ struct ReportOptions {
   AnimationOptions look;
   std::string title;  // what the report is of, e.g. the order's id; the product's name if empty
   Timeline timeline;  // a cell run's commands; empty for a plan alone
+  std::string answer;  // a line for the top, the cell's answer (a quote's time and cost); may be empty
 };
 
 std::string html_report(const LoadedProduct& product, const Plan& plan, const ReportOptions& options = {});
