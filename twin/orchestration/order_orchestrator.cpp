@@ -195,8 +195,7 @@ void OrderOrchestrator::try_begin_virtual() {
   next_action();
 }
 
-// A station's arm stands at the station's place; until its capability is heard, the speed
-// virtual assembly used.
+// A station's arm stands at the station's place.
 const OrderOrchestrator::Place* OrderOrchestrator::arm_at(const std::string& station) const {
   const auto s = places_.find(station);
   if (s == places_.end()) return nullptr;
@@ -206,6 +205,7 @@ const OrderOrchestrator::Place* OrderOrchestrator::arm_at(const std::string& sta
   return nullptr;
 }
 
+// Until the arm's capability is heard, at the speed virtual assembly used.
 std::vector<double> OrderOrchestrator::arm_times() const {
   const std::string& station = station_.empty() ? virtual_station_ : station_;
   const Numbers dock = places_.count(station) ? places_.at(station).dock : Numbers{0.6, 0, 0};

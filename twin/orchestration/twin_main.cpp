@@ -449,7 +449,9 @@ int main(int argc, char** argv) {
     const auto eq = r.find('=');
     double cost = -1;
     try {
-      if (eq != std::string::npos && eq > 0) cost = std::stod(r.substr(eq + 1));
+      std::size_t used = 0;
+      if (eq != std::string::npos && eq > 0) cost = std::stod(r.substr(eq + 1), &used);
+      if (used != r.size() - eq - 1) cost = -1;
     } catch (const std::exception&) {
     }
     if (!(cost >= 0 && std::isfinite(cost))) {
