@@ -22,7 +22,9 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs"
 
 cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_TSAN=ON -DCELL_BUILD_BENCHMARKS=OFF
-cmake --build build/tsan -j "$jobs"
+# Only what the labels below run (the unit tests of planning need no second thread).
+cmake --build build/tsan -j "$jobs" --target cellctl service_tests state_tests orchestration_tests dds_tests process_tests \
+  two_host_tests
 fastdds shm clean >/dev/null 2>&1 || true
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
   ctest --test-dir build/tsan --output-on-failure -j "$jobs" -L "blocks|dds|processes"

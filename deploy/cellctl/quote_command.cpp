@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/quote_answer.hpp"
 #include "deploy/cellctl/remote_submit.hpp"
 #include "deploy/cellctl/text_table.hpp"
 
@@ -41,24 +42,6 @@ struct Asked {
   json quote;         // its quote.json; null: none came
 };
 
-// A quote.json as a cell wrote it: checked before it is shown (it came over the network).
-json read_quote(const fs::path& file, std::string& why) {
-  std::ifstream in(file);
-  if (!in) return why = "no quote.json came back", json();
-  json q = json::parse(in, nullptr, false);
-  const auto number = [&q](const char* group, const char* key) {
-    return q.contains(group) && q[group].is_object() && q[group].contains(key) && q[group][key].is_number() &&
-           q[group][key].get<double>() >= 0;
-  };
-  if (q.is_discarded() || !q.is_object() || q.value("schema", "") != "agile-cell/quote" || !q["feasible"].is_boolean()) {
-    return why = file.string() + " is not a quote (schema agile-cell/quote)", json();
-  }
-  if (q["feasible"].get<bool>() && !(number("time_s", "makespan") && number("time_s", "wait") && number("cost", "total"))) {
-    return why = file.string() + " has no makespan, wait or total cost", json();
-  }
-  return q;
-}
-
 std::string unique_name(std::string name, std::set<std::string>& taken) {
   std::string candidate = name;
   for (int i = 2; taken.count(candidate); ++i) candidate = name + "-" + std::to_string(i);
@@ -66,12 +49,10 @@ std::string unique_name(std::string name, std::set<std::string>& taken) {
   return candidate;
 }
 
+// "8 margin, 2 collision" of a checked quote (read_quote).
 std::string findings_summary(const json& q) {
-  if (!q.contains("findings") || !q["findings"].is_array()) return "";
   std::map<std::string, int> kinds;
-  for (const auto& f : q["findings"]) {
-    if (f.is_object() && f.contains("kind") && f["kind"].is_string()) ++kinds[f["kind"].get<std::string>()];
-  }
+  for (const auto& f : q["findings"]) ++kinds[f["kind"].get<std::string>()];
   std::string out;
   for (const auto& [kind, n] : kinds) out += (out.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
   return out.empty() ? "none" : out;
@@ -80,9 +61,7 @@ std::string findings_summary(const json& q) {
 int run_quotes(const QuoteOptions& o) {
   std::vector<std::unique_ptr<Asked>> asked;
   std::set<std::string> names, domains;
-  const std::string stem = fs::path(o.product).stem().string();
-  const std::string stamp = std::to_string(std::chrono::duration_cast<std::chrono::seconds>(
-                                               std::chrono::system_clock::now().time_since_epoch()).count());
+  const std::string submission = quote_submission_id(o.product);
   for (const auto& file : o.cells) {
     auto a = std::make_unique<Asked>();
     a->cell = read_cell_config(file);
@@ -90,7 +69,7 @@ int run_quotes(const QuoteOptions& o) {
       throw ConfigError(file + ": domain " + std::to_string(a->cell.domain) + " is another cell's too: each cell quotes on its own domain");
     }
     a->name = unique_name(fs::path(file).stem().string(), names);
-    a->submission = RemoteSubmission{o.product, o.client, "quote-" + stem + "-" + stamp, (fs::path(o.out) / a->name).string(),
+    a->submission = RemoteSubmission{o.product, o.client, submission, (fs::path(o.out) / a->name).string(),
                                      o.sequence, a->cell.participant_settings(o.client),
                                      std::chrono::seconds(static_cast<long>(o.wait_s)), true, "[" + a->name + "] "};
     asked.push_back(std::move(a));
@@ -99,11 +78,14 @@ int run_quotes(const QuoteOptions& o) {
   {
     std::vector<std::thread> threads;
     for (auto& a : asked) {
+      std::error_code ignored;  // an answer of an earlier run must not pass for this one's
+      fs::remove(fs::path(a->submission.out) / "quote.json", ignored);
       threads.emplace_back([&a] {
         try {
           a->exit_code = submit_remote(a->submission, stop_quoting, &a->error);
         } catch (const std::exception& e) {
-          std::cerr << "[" << a->name << "] error: " << e.what() << '\n';
+          a->error = e.what();
+          std::cerr << "[" << a->name << "] error: " << a->error << '\n';
           a->exit_code = 1;
         }
       });
@@ -117,7 +99,8 @@ int run_quotes(const QuoteOptions& o) {
   json cells = json::array();
   for (auto& a : asked) {
     std::string why;
-    if (a->exit_code == 0) a->quote = read_quote(fs::path(a->submission.out) / "quote.json", why);
+    if (stop_quoting) why = "stopped before it answered";
+    else if (a->exit_code == 0) a->quote = read_quote(fs::path(a->submission.out) / "quote.json", o.client + "-" + submission, why);
     else why = a->error.empty() ? "its desk ended the request with exit " + std::to_string(a->exit_code) : a->error;
     json entry = {{"cell", a->name}, {"file", fs::absolute(a->cell.file).string()}, {"domain", a->cell.domain},
                   {"results", a->submission.out}};
@@ -149,15 +132,15 @@ int run_quotes(const QuoteOptions& o) {
       continue;
     }
     if (!q["feasible"].get<bool>()) {
-      table.add_row({a->name, "no", "-", "-", "-", "-", q.value("reason", std::string("")), ""});
+      table.add_row({a->name, "no", "-", "-", "-", "-", q["reason"].get<std::string>(), ""});
       continue;
     }
     std::string best;
     if (a.get() == fastest) best = "time";
     if (a.get() == cheapest) best += best.empty() ? "cost" : ", cost";
     table.add_row({a->name, "yes", fixed(q["time_s"]["makespan"].get<double>(), 1), fixed(q["time_s"]["wait"].get<double>(), 1),
-                   fixed(q["cost"]["total"].get<double>(), 2) + " " + q["cost"].value("currency", std::string("")),
-                   q.value("station", std::string("")), findings_summary(q), best});
+                   fixed(q["cost"]["total"].get<double>(), 2) + " " + q["cost"]["currency"].get<std::string>(),
+                   q["station"].get<std::string>(), findings_summary(q), best});
   }
   std::cout << "\nquotes for " << fs::path(o.product).filename().string() << ":\n";
   table.print(std::cout);
@@ -167,7 +150,8 @@ int run_quotes(const QuoteOptions& o) {
                     {"best_cost", cheapest ? json(cheapest->name) : json()}};
   const fs::path json_file = o.json_file.empty() ? fs::path(o.out) / "quotes.json" : fs::path(o.json_file);
   if (json_file.has_parent_path()) fs::create_directories(json_file.parent_path());
-  if (!(std::ofstream(json_file) << all.dump(2) << '\n')) {
+  // Text from the cells (reasons, findings) is written as it came; bytes that are not UTF-8 are replaced.
+  if (!(std::ofstream(json_file) << all.dump(2, ' ', false, json::error_handler_t::replace) << '\n')) {
     std::cerr << "error: cannot write " << json_file.string() << '\n';
     return 1;
   }

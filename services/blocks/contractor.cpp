@@ -15,7 +15,7 @@ Contractor::Contractor(std::string name, std::string resource_id, std::set<std::
   declare_input("RELEASE", {"order_id", "resource_id"});
   declare_input("ORDER_ENDED", {"order_id"});
   declare_input("IDLE");
-  declare_output("PROPOSE", {"call_id", "available", "reason", "earliest_start", "duration"});
+  declare_output("PROPOSE", {"call_id", "available", "reason", "earliest_start", "duration", "bid_time"});
   declare_output("REPLY", {"call_id", "confirmed", "reason", "ahead"});
   declare_output("RESERVED", {"order_id"});
   declare_output("AWARDED", {"call_id", "order_id", "duration"});
@@ -75,8 +75,7 @@ std::string Contractor::refusal(const std::string& order, const std::string& awa
 
 // Exclusive: after the holder's expected end and the expected holds of those waiting.
 // Shared: after the work taken on.
-double Contractor::earliest_start(const std::string& order) const {
-  const double now = now_();
+double Contractor::earliest_start(const std::string& order, double now) const {
   if (!exclusive_) return std::max(now, busy_until_);
   if (holder_.order.empty() || holder_.order == order) return now;
   double start = std::max(now, holder_.until);
@@ -100,9 +99,10 @@ void Contractor::propose(const Data& call) {
     offered["duration"] = e.duration;
     bids_[id] = std::move(offered);
   }
+  const double now = now_();
   emit("PROPOSE", {{"call_id", id}, {"available", e.available}, {"reason", e.reason},
-                   {"earliest_start", e.available ? earliest_start(get<std::string>(call, "order_id")) : 0.0},
-                   {"duration", e.duration}});
+                   {"earliest_start", e.available ? earliest_start(get<std::string>(call, "order_id"), now) : 0.0},
+                   {"duration", e.duration}, {"bid_time", now}});
 }
 
 void Contractor::reply(const std::string& call_id, const std::string& order, bool confirmed, const std::string& reason,

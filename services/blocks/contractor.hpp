@@ -14,7 +14,7 @@
 //    into its queue: its next bid starts after the work it has taken.
 //
 //   inputs                                         outputs
-//   CFP     (call_id, order_id, operation, ...)    PROPOSE  (call_id, available, reason, earliest_start, duration)
+//   CFP     (call_id, order_id, operation, ...)    PROPOSE  (call_id, available, reason, earliest_start, duration, bid_time)
 //   AWARD   (call_id, resource_id, order_id)       REPLY    (call_id, order_id, confirmed, reason, ahead)
 //   RELEASE (order_id, resource_id)                RESERVED (order_id): the holder changed, or the queue
 //   ORDER_ENDED (order_id)                         AWARDED  (the call's data, duration): work taken on
@@ -76,7 +76,7 @@ class Contractor : public BasicBlock {
     double duration = 0;
     std::set<std::string> calls;  // the awards it holds this resource by
   };
-  double earliest_start(const std::string& order) const;
+  double earliest_start(const std::string& order, double now) const;
   void award(const Data& award);
   void end(const std::string& order);
   void propose(const Data& call);

@@ -14,14 +14,14 @@ Negotiator::Negotiator(std::string name, std::string order_id, NegotiationSettin
   declare_input("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_input("CAPABILITY", {"resource_id", "operations"});
   declare_input("RESOURCE_GONE", {"resource_id"});
-  declare_input("PROPOSAL", {"call_id", "resource_id", "available", "reason", "earliest_start", "duration"});
+  declare_input("PROPOSAL", {"call_id", "resource_id", "available", "reason", "earliest_start", "duration", "bid_time"});
   declare_input("AWARD_REPLY", {"call_id", "resource_id", "confirmed", "reason", "ahead"});
   declare_input("TICK");
   declare_output("CFP", {"call_id", "order_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_output("AWARD", {"call_id", "resource_id", "order_id", "lease"});
   declare_output("AWARDED", {"call_id", "resource_id", "ahead", "earliest_start", "duration"});
   declare_output("UNAVAILABLE", {"call_id", "reason"});
-  declare_output("QUOTED", {"call_id", "resource_id", "earliest_start", "duration"});
+  declare_output("QUOTED", {"call_id", "resource_id", "earliest_start", "duration", "bid_time"});
 }
 
 void Negotiator::receive(const Event& e) {
@@ -52,10 +52,12 @@ void Negotiator::receive(const Event& e) {
   const std::string& resource = get<std::string>(e.data, "resource_id");
   if (e.name == "PROPOSAL") {
     const double start = get<double>(e.data, "earliest_start"), duration = get<double>(e.data, "duration");
-    if (get<bool>(e.data, "available") && (!std::isfinite(start) || !std::isfinite(duration) || duration < 0)) {
-      c.refusals[resource] = "its bid was not a finite start and duration >= 0";
+    const double bid_time = get_or<double>(e.data, "bid_time", start);
+    if (get<bool>(e.data, "available") &&
+        (!std::isfinite(start) || !std::isfinite(duration) || duration < 0 || !std::isfinite(bid_time))) {
+      c.refusals[resource] = "its bid was not a finite start, bid time and duration >= 0";
     } else if (get<bool>(e.data, "available")) {
-      c.bids[resource] = {resource, start, duration};
+      c.bids[resource] = {resource, start, duration, bid_time};
       c.refusals.erase(resource);
     } else {
       c.refusals[resource] = get<std::string>(e.data, "reason");
@@ -109,7 +111,7 @@ bool Negotiator::decide(const std::string& id) {
   if (!best) return false;
   if (c.quote) {
     emit("QUOTED", {{"call_id", id}, {"resource_id", best->resource_id}, {"earliest_start", best->earliest_start},
-                    {"duration", best->duration}});
+                    {"duration", best->duration}, {"bid_time", best->bid_time}});
     return true;
   }
   c.awarded = best->resource_id;

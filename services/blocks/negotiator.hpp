@@ -15,11 +15,12 @@
 //   inputs                                          outputs
 //   CALL (call_id, operation, part_type, station,   CFP (the call, with order_id)
 //         sources, count, duration)                 AWARD (call_id, resource_id, order_id, lease)
-//   ASK (as CALL: a call for quotes)                QUOTED (call_id, resource_id, earliest_start, duration)
+//   ASK (as CALL: a call for quotes)                QUOTED (call_id, resource_id, earliest_start, duration,
+//                                                           bid_time)
 //   CAPABILITY (resource_id, operations): who       AWARDED (call_id, resource_id, ahead,
 //     may answer                                             earliest_start, duration)
 //   RESOURCE_GONE (resource_id)                     UNAVAILABLE (call_id, reason)
-//   PROPOSAL (call_id, resource_id, available, reason, earliest_start, duration)
+//   PROPOSAL (call_id, resource_id, available, reason, earliest_start, duration, bid_time)
 //   AWARD_REPLY (call_id, resource_id, confirmed, reason, ahead)
 //   TICK: windows and waits (wall time)
 
@@ -37,6 +38,7 @@ struct Bid {
   std::string resource_id;
   double earliest_start = 0;  // sim s
   double duration = 0;        // s
+  double bid_time = 0;        // the bidder's sim time when it bid
 };
 
 // Which bid wins: the lowest cost. The interface is small so that a cell can weigh bids its

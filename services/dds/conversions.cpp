@@ -257,7 +257,7 @@ cell::CallForProposals to_call(const fb::Data& d) {
 fb::Data to_data(const cell::Proposal& p) {
   return {{"call_id", p.call_id().to_string()},   {"resource_id", p.resource_id().to_string()},
           {"available", p.available()},           {"reason", p.reason().to_string()},
-          {"earliest_start", p.earliest_start()}, {"duration", p.duration()}};
+          {"earliest_start", p.earliest_start()}, {"duration", p.duration()}, {"bid_time", p.bid_time()}};
 }
 
 cell::Proposal to_proposal(const fb::Data& d) {
@@ -268,6 +268,7 @@ cell::Proposal to_proposal(const fb::Data& d) {
   p.reason(message(d, "reason"));
   p.earliest_start(fb::get_or<double>(d, "earliest_start", 0));
   p.duration(fb::get_or<double>(d, "duration", 0));
+  p.bid_time(fb::get_or<double>(d, "bid_time", 0));
   return p;
 }
 

@@ -54,7 +54,9 @@ TEST_CASE("contractor: bids only for what it offers, after the orders it holds a
 
   // Held: o2 is offered the time after o1's expected end, and a place in the queue; o3 after both.
   now = 110;
-  CHECK(fb::get<double>(f.send("CFP", cfp("o2", "host", 20))[0].data, "earliest_start") == 130);
+  const auto bid_o2 = f.send("CFP", cfp("o2", "host", 20));
+  CHECK(fb::get<double>(bid_o2[0].data, "earliest_start") == 130);
+  CHECK(fb::get<double>(bid_o2[0].data, "bid_time") == 110);  // its clock when it bid: 20 s of queue
   const auto queued = f.send("AWARD", award("o2", "host"));
   CHECK(fb::get<bool>(queued[0].data, "confirmed"));
   CHECK(fb::get<std::int64_t>(queued[0].data, "ahead") == 1);
@@ -128,6 +130,11 @@ fb::Data proposal(const std::string& call, const std::string& resource, double s
   return {{"call_id", call},         {"resource_id", resource}, {"available", true},
           {"reason", std::string()}, {"earliest_start", start}, {"duration", duration}};
 }
+fb::Data proposal(const std::string& call, const std::string& resource, double start, double duration, double bid_time) {
+  fb::Data p = proposal(call, resource, start, duration);
+  p["bid_time"] = bid_time;
+  return p;
+}
 fb::Data reply(const std::string& call, const std::string& resource, bool confirmed, long ahead = 0) {
   return {{"call_id", call},         {"resource_id", resource}, {"confirmed", confirmed},
           {"reason", std::string(confirmed ? "" : "busy")}, {"ahead", std::int64_t(ahead)}};
@@ -176,11 +183,12 @@ TEST_CASE("negotiator: a call for quotes reports the best bid and awards nothing
   f.send("CAPABILITY", capability("buffer-1", "give"));
   REQUIRE(names<fb::Negotiator>(f.send("ASK", cfp("o1", "fetch"))) == Names{"CFP"});
   CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 10, 30)).empty());
-  const auto quoted = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 20, 5));
+  const auto quoted = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 20, 5, 12));
   REQUIRE(names<fb::Negotiator>(quoted) == Names{"QUOTED"});
   CHECK(fb::get<std::string>(quoted[0].data, "resource_id") == "robot-2");
   CHECK(fb::get<double>(quoted[0].data, "earliest_start") == 20);
   CHECK(fb::get<double>(quoted[0].data, "duration") == 5);
+  CHECK(fb::get<double>(quoted[0].data, "bid_time") == 12);  // its queue: 8 s on its own clock
   CHECK(f.block().open_calls() == 0);
   CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 1)).empty());  // late: the call is settled
 

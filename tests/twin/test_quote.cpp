@@ -5,12 +5,12 @@
 #include "twin/orchestration/quote.hpp"
 
 TEST_CASE("quote: the fetches and the arm as a two-stage flow, after the station's queue", "[twin][quote]") {
-  twin::QuoteBids bids{"station-2", "mobile-robot-1", 130, 100, {4, 4, 4}, {10, 1, 10}};
+  twin::QuoteBids bids{"station-2", "mobile-robot-1", 30, 0, {4, 4, 4}, {10, 1, 10}};
   twin::Rates rates{50, {{"station-2", 360}, {"mobile-robot-1", 36}, {"station-1", 1e6}}, "CHF"};
-  const twin::Quote q = twin::estimate_quote(bids, 100, rates);
+  const twin::Quote q = twin::estimate_quote(bids, rates);
   CHECK(q.feasible);
-  CHECK(q.wait_s == Approx(30));  // the station is free at 130
-  // From 130: parts delivered at 134, 138, 142; the arm: 134-144, 144-145, 145-155.
+  CHECK(q.wait_s == Approx(30));  // the station is free in 30 s
+  // From 30: parts delivered at 34, 38, 42; the arm: 34-44, 44-45, 45-55.
   CHECK(q.makespan_s == Approx(55));
   CHECK(q.station_s == Approx(25));
   CHECK(q.robot_s == Approx(12));
@@ -19,12 +19,12 @@ TEST_CASE("quote: the fetches and the arm as a two-stage flow, after the station
   CHECK(q.total_cost == Approx(50 + 2.5 + 0.12));
   CHECK(q.currency == "CHF");
 
-  // A robot busy past the station's start holds the arm up; a bid earlier than now counts from now.
-  bids.robot_start = 150;
-  bids.station_start = 90;
-  const twin::Quote later = twin::estimate_quote(bids, 100, rates);
+  // A robot busy past the station's start holds the arm up.
+  bids.robot_wait = 50;
+  bids.station_wait = 0;
+  const twin::Quote later = twin::estimate_quote(bids, rates);
   CHECK(later.wait_s == 0);
-  CHECK(later.makespan_s == Approx(75));  // delivered 154, 158, 162; arm 154-164, 164-165, 165-175
+  CHECK(later.makespan_s == Approx(75));  // delivered 54, 58, 62; arm 54-64, 64-65, 65-75
   CHECK(later.station_s == Approx(75));
 }
 
@@ -37,7 +37,7 @@ TEST_CASE("quote: quote.json says feasible or why not, the time and the cost, an
   CHECK(no["feasible"] == false);
   CHECK(no["reason"] == "nobody offered give Shaft");
   CHECK_FALSE(no.contains("cost"));
-  const auto yes = twin::quote_json("o1", twin::estimate_quote({"station-1", "mobile-robot-1", 0, 0, {1}, {2}}, 0, rates), 1, findings);
+  const auto yes = twin::quote_json("o1", twin::estimate_quote({"station-1", "mobile-robot-1", 0, 0, {1}, {2}}, rates), 1, findings);
   CHECK(yes["feasible"] == true);
   CHECK(yes["time_s"]["makespan"] == Approx(3));
   CHECK(yes["cost"]["total"] == Approx(20));

@@ -21,9 +21,9 @@ std::string text_of(const std::filesystem::path& file) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-twin::Plan plan_of(const twin::LoadedProduct& loaded) {
+twin::Plan plan_of(const twin::LoadedProduct& loaded, twin::PlannerOptions options = {}) {
   twin::SearchSequencePlanner sequence;
-  return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"));
+  return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"), options);
 }
 
 // A copy of the nested Cranfield with `from` replaced by `to` in its AML, beside its meshes.
@@ -160,7 +160,12 @@ TEST_CASE("subassemblies: one that cannot be built on its own makes the plan inc
   std::filesystem::remove_all(file.parent_path());
   REQUIRE(test::part(loaded.product, "back").subassembly == "Plates");
   REQUIRE(test::part(loaded.product, "front").subassembly == "Plates");
-  const twin::Plan plan = plan_of(loaded);
+  // With the plates as one unit the shaft cannot go in between them, and the top level's
+  // search would try every order (10,000 backtracks: 75 s, under ASan 8 minutes); what is
+  // asked here is said by the subassembly's own planning, before that.
+  twin::PlannerOptions bounded;
+  bounded.max_backtracks = 50;
+  const twin::Plan plan = plan_of(loaded, bounded);
   CHECK_FALSE(plan.complete);
   const auto said = std::find_if(plan.findings.begin(), plan.findings.end(), [](const auto& f) {
     return f.message.rfind("subassembly Plates: ", 0) == 0 && f.message.find("front") != std::string::npos;

@@ -40,13 +40,13 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
                                "waiting"});
   declare_input("RESOURCE_GONE", {"resource_id"});
   declare_input("AWARDED", {"call_id", "resource_id", "ahead"});
-  declare_input("QUOTED", {"call_id", "resource_id", "earliest_start", "duration"});
+  declare_input("QUOTED", {"call_id", "resource_id", "earliest_start", "duration", "bid_time"});
   declare_input("UNAVAILABLE", {"call_id", "reason"});
   declare_input("COMMAND_EVENT", {"command_id", "order_id", "state", "reason", "sim_time"});
   declare_input("SIM_REPLY", {"request_id", "ok", "error", "collided"});
   declare_output("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_output("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
-  declare_output("QUOTE", {"station", "station_start", "robot", "robot_start", "fetch", "arm"});
+  declare_output("QUOTE", {"station", "station_wait", "robot", "robot_wait", "fetch", "arm"});
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
@@ -259,6 +259,11 @@ void OrderOrchestrator::consider_moving_to(const std::string& station) {
 
 void OrderOrchestrator::on_resource_gone(const std::string& id) {
   places_.erase(id);
+  if (state() == "QUOTING" && (id == station_ || id == robot_ || std::any_of(buffer_of_.begin(), buffer_of_.end(), [&id](const auto& b) {
+                                 return b.second == id;
+                               }))) {
+    return fail(id + " disappeared while the order asked for quotes");
+  }
   if (state() == "QUEUED" && id == station_) {
     awarded_.erase(station_);
     emit("FINDING", {{"kind", std::string("rebooked")},
@@ -346,17 +351,23 @@ void OrderOrchestrator::ask_for_quotes() {
   for (const auto& [type, count] : parts_per_type()) emit("ASK", call_data(kGive + type, "give", type, "", "", count, 0));
 }
 
+// How long the bidder's queue holds the work up, on the bidder's own clock (the twin's may
+// run a little ahead or behind it).
+double OrderOrchestrator::queue_of(const Data& quoted) {
+  return std::max(0.0, get<double>(quoted, "earliest_start") - get<double>(quoted, "bid_time"));
+}
+
 void OrderOrchestrator::on_quoted(const Data& d) {
   const std::string what = get<std::string>(d, "call_id").substr(settings_.order_id.size() + 1);
   const std::string& resource = get<std::string>(d, "resource_id");
   if (what == kHost) {
     station_ = resource;
-    station_start_ = get<double>(d, "earliest_start");
+    station_wait_ = queue_of(d);
   } else if (what.rfind(kGive, 0) == 0) {
     buffer_of_[what.substr(kGive.size())] = resource;
   } else if (what == kRobot) {
     robot_ = resource;
-    robot_start_ = get<double>(d, "earliest_start");
+    robot_wait_ = queue_of(d);
     robot_duration_ = get<double>(d, "duration");
     return quote_when_arm_known();
   }
@@ -366,8 +377,8 @@ void OrderOrchestrator::on_quoted(const Data& d) {
 // The arm's times need its speed: its capability may come later than the station's.
 void OrderOrchestrator::quote_when_arm_known() {
   if (robot_.empty() || !arm_at(station_)) return;
-  emit("QUOTE", {{"station", station_}, {"station_start", station_start_}, {"robot", robot_},
-                 {"robot_start", robot_start_}, {"fetch", fetch_times()}, {"arm", arm_times()}});
+  emit("QUOTE", {{"station", station_}, {"station_wait", station_wait_}, {"robot", robot_},
+                 {"robot_wait", robot_wait_}, {"fetch", fetch_times()}, {"arm", arm_times()}});
   enter("ENDED");
   emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
 }

@@ -40,11 +40,12 @@
 //
 //   inputs: START, TICK, CAPABILITY (resource_id, kind, position, dock, speed, angular_speed,
 //           reserved_by, waiting), RESOURCE_GONE (resource_id), AWARDED (call_id,
-//           resource_id, ahead), QUOTED (call_id, resource_id, earliest_start, duration),
+//           resource_id, ahead), QUOTED (call_id, resource_id, earliest_start, duration, bid_time),
 //           UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
 //           order_id, state, reason, sim_time), SIM_REPLY (request_id, ok, error, collided, ...)
-//   outputs: CALL and ASK (to the Negotiator), QUOTE (station, station_start, robot,
-//            robot_start, fetch: s per part in planned order, arm: s per step), RELEASE, COMMAND, CANCEL (fetches not delivered when
+//   outputs: CALL and ASK (to the Negotiator), QUOTE (station, station_wait, robot,
+//            robot_wait: s of their queues; fetch: s per part in planned order, arm: s per
+//            step), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: its body, assembled in place),
 //            FINISHED (complete, error, take_up: ended for the next twin to take the order up)
@@ -139,6 +140,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   void ask_for_quotes();
   void on_quoted(const fb::Data& quote);
   void quote_when_arm_known();
+  static double queue_of(const fb::Data& quoted);
   std::vector<double> fetch_times() const;  // s per part in planned order: the robot's bid, shared by distance
   fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
                      const std::string& station, const std::string& sources, long count, double duration) const;
@@ -191,7 +193,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   long ahead_ = -1;                               // in the station's queue, as last reported
   bool arm_held_ = false;
   bool robot_called_ = false;
-  double station_start_ = 0, robot_start_ = 0, robot_duration_ = 0;  // quotes: the best bids
+  double station_wait_ = 0, robot_wait_ = 0, robot_duration_ = 0;  // quotes: the best bids
   std::set<std::string> delivered_, spawned_;
   struct Sent {
     fb::Data command;

@@ -13,20 +13,22 @@ double rate(const Rates& rates, const std::string& resource) {
 
 }  // namespace
 
-Quote estimate_quote(const QuoteBids& bids, double now, const Rates& rates) {
+Quote estimate_quote(const QuoteBids& bids, const Rates& rates) {
   Quote q;
   q.feasible = true;
   q.station = bids.station;
   q.robot = bids.robot;
-  const double start = std::max(now, bids.station_start);
-  double delivered = std::max(start, bids.robot_start);
+  // From now: the station is the order's after its queue, the robot sets out once the station
+  // is the order's and its own earlier fetches are done.
+  const double start = std::max(0.0, bids.station_wait);
+  double delivered = std::max(start, bids.robot_wait);
   double arm_done = start;
   for (std::size_t i = 0; i < bids.arm.size(); ++i) {
     if (i < bids.fetch.size()) delivered += bids.fetch[i];
     arm_done = std::max(arm_done, delivered) + bids.arm[i];
   }
-  q.wait_s = start - now;
-  q.makespan_s = arm_done - now;
+  q.wait_s = start;
+  q.makespan_s = arm_done;
   q.station_s = arm_done - start;
   q.robot_s = std::accumulate(bids.fetch.begin(), bids.fetch.end(), 0.0);
   q.setup_cost = rates.setup_cost;

@@ -13,11 +13,11 @@
 
 namespace twin {
 
-// What the resources offered, in sim time (s; the physical cell's time).
+// What the resources offered, in s of sim time (the physical cell's time).
 struct QuoteBids {
   std::string station, robot;
-  double station_start = 0;  // the station's bid: after the orders in its queue
-  double robot_start = 0;    // the robot's bid: after the fetches it has taken on
+  double station_wait = 0;  // the station's bid: the orders in its queue, from now
+  double robot_wait = 0;    // the robot's bid: the fetches it has taken on, from now
   std::vector<double> fetch;  // each part's fetch, in planned order
   std::vector<double> arm;    // the arm's time for each step: from the dock, in, back
 };
@@ -43,7 +43,7 @@ struct Quote {
 // The fetches and the arm as a two-stage flow: the robot starts once the station is the
 // order's (and the robot is free), brings the parts one after another; the arm inserts each
 // once it is delivered and the step before is done.
-Quote estimate_quote(const QuoteBids& bids, double now, const Rates& rates);
+Quote estimate_quote(const QuoteBids& bids, const Rates& rates);
 Quote infeasible_quote(const std::string& reason, const Rates& rates);
 
 // quote.json (schema agile-cell/quote): the quote, the plan's size and every finding.

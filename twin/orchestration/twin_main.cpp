@@ -355,9 +355,9 @@ class TwinProcess {
     std::optional<twin::Quote> quote;
     r.add(std::make_unique<fb::ActionBlock>("quote", [this, &quote](const fb::Data& d) {
       twin::QuoteBids bids{fb::get<std::string>(d, "station"), fb::get<std::string>(d, "robot"),
-                           fb::get<double>(d, "station_start"), fb::get<double>(d, "robot_start"),
+                           fb::get<double>(d, "station_wait"), fb::get<double>(d, "robot_wait"),
                            fb::get<fb::Numbers>(d, "fetch"), fb::get<fb::Numbers>(d, "arm")};
-      quote = twin::estimate_quote(bids, clock_.now(), options_.rates);
+      quote = twin::estimate_quote(bids, options_.rates);
     }));
     r.connect("orchestrator", "QUOTE", "quote", "REQ");
     bool finished = false;
