@@ -45,14 +45,15 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer)
   const auto live = observer.orders();
   if (store) {
     for (const auto& o : store->orders()) {
-      orders.push_back({{"order", o.order}, {"state", o.state}, {"reason", o.reason}});
+      orders.push_back({{"order", o.order}, {"state", o.state}, {"reason", o.reason}, {"quote", o.quote}});
       listed.insert(o.order);
     }
   }
   for (const auto& [id, s] : live) {
     if (listed.count(id)) continue;
     const bool failed = s.state() == cell::FAILED;
-    orders.push_back({{"order", id}, {"state", state_of(s.state())}, {"reason", failed ? s.message().to_string() : ""}});
+    orders.push_back({{"order", id}, {"state", state_of(s.state())}, {"reason", failed ? s.message().to_string() : ""},
+                      {"quote", false}});
   }
 
   json resources = json::array();

@@ -99,6 +99,14 @@ TEST_CASE("quotes: two cells answer with time, cost and findings, the best by ti
           std::string::npos);
   }
 
+  // The manufacturer sees the quotes among the cell's orders.
+  REQUIRE(test::cellctl({"status", "--json", "--cell", fast.string(), "--state-dir", (dir / "state-fast").string()},
+                        dir / "status.log", 60s) == 0);
+  const std::string said = test::read_text(dir / "status.log");  // the JSON object, whatever else was said
+  const auto status = nlohmann::json::parse(said.substr(said.find('{'), said.rfind('}') - said.find('{') + 1));
+  REQUIRE(status["orders"].size() == 2);
+  for (const auto& o : status["orders"]) CHECK(o["quote"] == true);
+
   CHECK(test::cellctl({"down", "--domain", "228"}, dir / "down-fast.log", 30s) == 0);
   CHECK(test::cellctl({"down", "--domain", "229"}, dir / "down-thrifty.log", 30s) == 0);
   CHECK(up_fast.wait_for_exit(20s) == 0);
