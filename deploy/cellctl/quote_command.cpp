@@ -38,7 +38,7 @@ struct Asked {
   CellConfig cell;
   RemoteSubmission submission;
   int exit_code = -1;
-  std::string error;  // why it did not answer
+  std::string error;  // why it gave no answer
   json quote;         // its quote.json; null: none came
 };
 
@@ -105,6 +105,7 @@ int run_quotes(const QuoteOptions& o) {
     json entry = {{"cell", a->name}, {"file", fs::absolute(a->cell.file).string()}, {"domain", a->cell.domain},
                   {"results", a->submission.out}};
     if (a->quote.is_null()) {
+      a->error = why;
       entry["answered"] = false;
       entry["reason"] = why;
     } else {
@@ -124,11 +125,7 @@ int run_quotes(const QuoteOptions& o) {
   for (const auto& a : asked) {
     const json& q = a->quote;
     if (q.is_null()) {
-      std::string why;
-      for (const auto& c : cells) {
-        if (c["cell"] == a->name) why = c["reason"].get<std::string>();
-      }
-      table.add_row({a->name, "no answer", "-", "-", "-", "-", why, ""});
+      table.add_row({a->name, "no answer", "-", "-", "-", "-", a->error, ""});
       continue;
     }
     if (!q["feasible"].get<bool>()) {
