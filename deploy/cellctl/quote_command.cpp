@@ -60,12 +60,13 @@ std::string findings_summary(const json& q) {
 
 int run_quotes(const QuoteOptions& o) {
   std::vector<std::unique_ptr<Asked>> asked;
-  std::set<std::string> names, domains;
+  std::set<std::string> names;
+  std::set<int> domains;
   const std::string submission = quote_submission_id(o.product);
   for (const auto& file : o.cells) {
     auto a = std::make_unique<Asked>();
     a->cell = read_cell_config(file);
-    if (!domains.insert(std::to_string(a->cell.domain)).second) {
+    if (!domains.insert(a->cell.domain).second) {
       throw ConfigError(file + ": domain " + std::to_string(a->cell.domain) + " is another cell's too: each cell quotes on its own domain");
     }
     a->name = unique_name(fs::path(file).stem().string(), names);

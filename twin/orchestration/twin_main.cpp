@@ -181,9 +181,7 @@ class TwinProcess {
       summary = text;
     }
     write_plan(product, plan, out / "plan.json", {}, summary);
-    twin::AnimationOptions look;
-    look.gripper = options_.gripper;
-    twin::write_gltf_animation(product, plan, out / "animation.gltf", look);
+    write_animation(product, plan);
     status("DONE", summary, 1);
     result(true, (out / "plan.json").string(), "", "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);
@@ -245,6 +243,15 @@ class TwinProcess {
     report.timeline = timeline;
     report.answer = answer;
     twin::write_html_report(product, plan, file.parent_path() / "report.html", report);
+  }
+
+  // animation.gltf in the order's folder; its path.
+  std::filesystem::path write_animation(const twin::LoadedProduct& product, const twin::Plan& plan) const {
+    const auto file = std::filesystem::absolute(options_.out) / "animation.gltf";
+    twin::AnimationOptions look;
+    look.gripper = options_.gripper;
+    twin::write_gltf_animation(product, plan, file, look);
+    return file;
   }
 
   using Inputs = std::vector<std::pair<const char*, const char*>>;  // (block, input)
@@ -399,10 +406,7 @@ class TwinProcess {
       return watchdog.exit(end_quote(product, quote ? *quote : why, validated));
     }
     write_plan(product, validated, plan_file, orchestrator.timeline());
-    const auto animation = plan_file.parent_path() / "animation.gltf";
-    twin::AnimationOptions look;
-    look.gripper = options_.gripper;
-    twin::write_gltf_animation(product, validated, animation, look);
+    const auto animation = write_animation(product, validated);
     if (!orchestrator.error().empty()) return watchdog.exit(end_with(1, orchestrator.error(), plan_file.string(), true));
     result(true, plan_file.string(), animation.string(), "");
     if (store_) store_->set_order(options_.order, "DONE", "", 0);
