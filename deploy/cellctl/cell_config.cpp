@@ -263,6 +263,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   for (std::size_t i = 0; i < c.buffers.size(); ++i) named.push_back({c.buffers[i].id, buffer_nodes[i]});
   std::set<std::string> ids;
   for (const auto& [id, node] : named) {
+    // An id is a DDS partition and a topic's name in the permissions, where *, ? and [ are
+    // patterns: one such id would let a resource speak for others.
+    if (id.empty() || id.size() > 64 ||
+        id.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") != std::string::npos) {
+      throw ConfigError(where(file, node) + ": a resource id is 1 to 64 of A-Z, a-z, 0-9, '.', '-' and '_' ('" + id + "' is not)");
+    }
     if (!ids.insert(id).second) throw ConfigError(where(file, node) + ": a second resource is called '" + id + "'");
   }
   // A client's id names its DDS-Security identity too: none may be another's.

@@ -8,6 +8,10 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <iostream>
+#include <set>
+#include <type_traits>
+#include <utility>
 #include <malloc.h>
 #include <mutex>
 #include <stdexcept>
@@ -51,6 +55,11 @@ inline bool access_controlled(const fdds::DomainParticipant& participant) {
 // DDS-Security permissions then let a resource write its own and no other's
 // (deploy/cellctl/pki_policy.cpp).
 inline bool owned_topic(const std::string& topic) { return topic == "cell/capabilities" || topic == "cell/command_events"; }
+
+template <class T, class = void>
+struct has_resource_id : std::false_type {};
+template <class T>
+struct has_resource_id<T, std::void_t<decltype(std::declval<const T&>().resource_id())>> : std::true_type {};
 
 // Settings with the partition(s) `owner` writes an owned topic in.
 inline QosSettings owned_by(std::vector<std::string> owner, QosSettings settings = {}) {
@@ -222,6 +231,8 @@ class Reader : private fdds::DataReaderListener {
     subscriber_ = participant_->create_subscriber(with_partitions(
         fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && owned_topic(topic) ? every_partition(*participant_)
                                                                                         : settings.partitions));
+    check_writers_ = owned_topic(topic) && access_controlled(*participant_);
+    topic_ = topic;
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
   }
@@ -274,7 +285,7 @@ class Reader : private fdds::DataReaderListener {
     fdds::SampleInfoSeq infos;
     const auto visit = [&](auto&& each) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        if (infos[i].valid_data) each(samples[i]);
+        if (infos[i].valid_data && from_its_owner(samples[i], infos[i])) each(samples[i]);
       }
       reader->return_loan(samples, infos);
     };
@@ -293,8 +304,28 @@ class Reader : private fdds::DataReaderListener {
     }
   }
 
+  // Under DDS-Security a resource may write an owned topic in its own partition only; a sample
+  // it wrote there about another resource is dropped (the writer said once, on stderr).
+  bool from_its_owner(const T& sample, const fdds::SampleInfo& info) {
+    if constexpr (has_resource_id<T>::value) {
+      if (!check_writers_) return true;
+      const auto writer = info.sample_identity.writer_guid();
+      if (writer_speaks_for(*participant_, writer, sample.resource_id().to_string())) return true;
+      if (impostors_.insert(writer).second) {
+        std::cerr << "dropped a sample on " << topic_ << " about '" << sample.resource_id() << "' from writer " << writer
+                  << ", which DDS-Security lets write only about another resource\n";
+      }
+      return false;
+    } else {
+      return true;
+    }
+  }
+
   ParticipantPtr participant_;
   TopicKind kind_;
+  bool check_writers_ = false;
+  std::string topic_;
+  std::set<eprosima::fastrtps::rtps::GUID_t> impostors_;  // used by the draining thread only
   std::function<void(const T&)> on_sample_;
   std::function<void(const T&)> on_gone_;
   std::atomic<int> requests_{0};  // drain calls not yet served

@@ -1,6 +1,8 @@
 #include "services/dds/participant.hpp"
 
+#include <algorithm>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
@@ -12,6 +14,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/writer/WriterDiscoveryInfo.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include "cell_idl/simulationPubSubTypes.h"
@@ -22,12 +25,33 @@ constexpr std::uint32_t kMaxParticipantsPerHost = 32;
 
 namespace {
 
+}  // namespace
+
 // Says when another participant's lease ran out while it may still live (a process starved
 // of CPU for the whole lease): until discovery matches the two again, what they write to
 // each other is lost, and a call that gets no answer from a live resource is the sign.
+// Keeps the partitions of every remote writer that has some (writer_speaks_for()).
 class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
  public:
   explicit DiscoveryLog(std::string name) : name_(std::move(name)) {}
+
+  // Called before the writer is matched to any reader of ours, so before its first sample.
+  // Kept when it goes: its last samples may still be taken after (a state topic's instance
+  // that lost its writers). A few entries per process that ever wrote in a partition.
+  void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    using Info = eprosima::fastrtps::rtps::WriterDiscoveryInfo;
+    if (info.status == Info::REMOVED_WRITER) return;
+    const auto& names = info.info.m_qos.m_partition.names();
+    if (names.empty()) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    partitions_[info.info.guid()] = std::vector<std::string>(names.begin(), names.end());
+  }
+  bool writes_in(const eprosima::fastrtps::rtps::GUID_t& writer, const std::string& partition) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = partitions_.find(writer);
+    return it != partitions_.end() && std::find(it->second.begin(), it->second.end(), partition) != it->second.end();
+  }
   void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     if (info.status == eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
@@ -47,7 +71,18 @@ class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
 
  private:
   std::string name_;
+  mutable std::mutex mutex_;
+  std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
 };
+
+bool writer_speaks_for(const eprosima::fastdds::dds::DomainParticipant& participant,
+                       const eprosima::fastrtps::rtps::GUID_t& writer, const std::string& resource_id) {
+  if (writer.guidPrefix == participant.guid().guidPrefix) return true;  // ours: checked when created
+  const auto* log = dynamic_cast<const DiscoveryLog*>(participant.get_listener());
+  return !resource_id.empty() && log && log->writes_in(writer, resource_id);
+}
+
+namespace {
 
 // Fast DDS 2.9.1 walks the participant's list of local readers (WLP::readers_, a std::vector)
 // without a lock whenever a matched writer's liveliness changes (its first sample, a lease

@@ -31,4 +31,12 @@ using ParticipantPtr = std::shared_ptr<eprosima::fastdds::dds::DomainParticipant
 // refuses to create it.
 ParticipantPtr make_participant(const std::string& name, const ParticipantSettings& settings);
 
+// Whether `writer` (a sample's writer) writes in the partition `resource_id`: under
+// DDS-Security the partition is what the writer's permissions prove (endpoints.hpp,
+// owned_topic), so a sample about a resource counts only from a writer in that resource's
+// partition. A writer of `participant` itself counts (its permissions were checked when it
+// was made); an unknown one does not.
+bool writer_speaks_for(const eprosima::fastdds::dds::DomainParticipant& participant,
+                       const eprosima::fastrtps::rtps::GUID_t& writer, const std::string& resource_id);
+
 }  // namespace dds

@@ -183,6 +183,21 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     CHECK_THROWS_WITH((dds::Reader<cell::Command, cell::CommandPubSubType>(as_buffer_2, dds::command_topic("buffer-1"),
                                                                            dds::TopicKind::events, [](const cell::Command&) {})),
                       Catch::Contains("cannot create a reader on cell/commands/buffer-1: this identity's DDS-Security"));
+    // In its own partition, a capability that says it is buffer-1's: the readers drop it.
+    dds::Writer<cell::Capability, cell::CapabilityPubSubType> forger(as_buffer_2, "cell/capabilities", dds::TopicKind::state,
+                                                                     dds::owned_by({"buffer-2"}));
+    REQUIRE(forger.wait_for_readers(1, 10s));
+    cell::Capability forged;
+    forged.resource_id("buffer-1");
+    forged.kind("buffer");
+    forged.stock().push_back(cell::PartStock());
+    forged.stock().back().part_type("Forged");
+    forged.stock().back().count(5);
+    for (int i = 0; i < 3; ++i) {
+      forger.write(forged);
+      std::this_thread::sleep_for(500ms);
+    }
+    CHECK_FALSE(trusted_sees.saw_part_type("Forged"));
   }
 
   {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.
