@@ -368,12 +368,12 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       fs::remove(pid_file(cell.domain));
       throw;
     }
-    std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
-              << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"
-              << std::endl;
     const auto log = [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; };
     OrderDesk desk(cell, store, log);
     RemoteDesk remote(cell, store, observer, log);
+    std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
+              << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"
+              << std::endl;
     while (!stop_requested) {
       if (world_lost) desk.interrupt_all();
       world_lost = false;

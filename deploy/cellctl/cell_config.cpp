@@ -178,7 +178,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
-              "setup_cost", "currency"});
+              "setup_cost", "currency", "standby_twins"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -213,6 +213,8 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, network, "peers", c.peers);
     if (c.interfaces.empty()) throw ConfigError(where(file, network) + ": network needs the host's interfaces (IPv4 addresses)");
   }
+  read(file, root, "standby_twins", c.standby_twins);
+  if (c.standby_twins < 0 || c.standby_twins > 16) throw ConfigError(where(file, root["standby_twins"]) + ": standby_twins must be 0..16");
   read_cost(file, root, "setup_cost", c.setup_cost);
   read(file, root, "currency", c.currency);
   if (c.currency.empty() || c.currency.size() > 8) throw ConfigError(where(file, root["currency"]) + ": currency is 1 to 8 characters");
@@ -322,24 +324,45 @@ void add_network(std::vector<std::string>& argv, const CellConfig& c) {
   if (c.interfaces.empty() && !c.localhost_only) argv.push_back("--all-interfaces");
 }
 
+// A twin's options that are the cell's, not the order's.
+std::vector<std::string> twin_cell_argv(const CellConfig& c, const std::filesystem::path& bin) {
+  std::vector<std::string> argv{(bin / "twin").string(), "--domain", std::to_string(c.domain),
+                                "--lease", std::to_string(c.liveliness_lease), "--quiet"};
+  add_network(argv, c);
+  add_security(argv, c);
+  return argv;
+}
+
 }  // namespace
+
+std::vector<std::string> twin_standby_argv(const CellConfig& c, const std::filesystem::path& bin) {
+  auto argv = twin_cell_argv(c, bin);
+  argv.push_back("--standby");
+  return argv;
+}
+
+std::vector<std::string> twin_order_args(const CellConfig& c, const std::string& order, const std::string& product,
+                                         const std::string& out, const std::string& sequence, const std::string& path,
+                                         const std::filesystem::path& state_dir, double wait_s, bool quote) {
+  std::vector<std::string> args{"--order", order, "--product", product, "--out", out, "--sequence", sequence,
+                                "--path", path, "--wait", std::to_string(wait_s)};
+  if (!state_dir.empty()) args.insert(args.end(), {"--state-dir", state_dir.string()});
+  add_gripper(args, c.gripper);
+  if (quote) {
+    args.insert(args.end(), {"--quote", "--setup-cost", std::to_string(c.setup_cost), "--currency", c.currency});
+    for (const auto& s : c.stations) args.insert(args.end(), {"--cost-per-hour", s.id + "=" + std::to_string(s.cost_per_hour)});
+    for (const auto& r : c.robots) args.insert(args.end(), {"--cost-per-hour", r.id + "=" + std::to_string(r.cost_per_hour)});
+  }
+  return args;
+}
 
 std::vector<std::string> twin_argv(const CellConfig& c, const std::filesystem::path& bin, const std::string& order,
                                    const std::string& product, const std::string& out, const std::string& sequence,
                                    const std::string& path, const std::filesystem::path& state_dir, double wait_s,
                                    bool quote) {
-  std::vector<std::string> argv{(bin / "twin").string(), "--domain", std::to_string(c.domain), "--order", order,
-                                "--product", product, "--out", out, "--sequence", sequence, "--path", path, "--wait",
-                                std::to_string(wait_s), "--lease", std::to_string(c.liveliness_lease), "--quiet"};
-  if (!state_dir.empty()) argv.insert(argv.end(), {"--state-dir", state_dir.string()});
-  add_network(argv, c);
-  add_security(argv, c);
-  add_gripper(argv, c.gripper);
-  if (quote) {
-    argv.insert(argv.end(), {"--quote", "--setup-cost", std::to_string(c.setup_cost), "--currency", c.currency});
-    for (const auto& s : c.stations) argv.insert(argv.end(), {"--cost-per-hour", s.id + "=" + std::to_string(s.cost_per_hour)});
-    for (const auto& r : c.robots) argv.insert(argv.end(), {"--cost-per-hour", r.id + "=" + std::to_string(r.cost_per_hour)});
-  }
+  std::vector<std::string> argv = twin_cell_argv(c, bin);
+  const auto order_args = twin_order_args(c, order, product, out, sequence, path, state_dir, wait_s, quote);
+  argv.insert(argv.end(), order_args.begin(), order_args.end());
   return argv;
 }
 

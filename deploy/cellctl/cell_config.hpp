@@ -86,6 +86,9 @@ struct CellConfig {
   // `cost_per_hour:` for the time the order uses it, in `currency:`.
   double setup_cost = 0;
   std::string currency = "EUR";
+  // `standby_twins:` twins cellctl up starts before orders come, so that an order's twin has
+  // joined the cell already (deploy/cellctl/twin_pool.hpp); 0: each twin starts with its order.
+  int standby_twins = 1;
 
   std::vector<std::string> resource_ids() const;
   // How a participant of this cell with `identity` (docs/security.md) joins its domain.
@@ -118,5 +121,11 @@ std::vector<std::string> twin_argv(const CellConfig& cell, const std::filesystem
                                    const std::string& product, const std::string& out, const std::string& sequence,
                                    const std::string& path, const std::filesystem::path& state_dir, double wait_s = 30,
                                    bool quote = false);
+// The same twin in two halves: one started before its order (--standby), and the order's
+// options it then reads (twin_pool.hpp).
+std::vector<std::string> twin_standby_argv(const CellConfig& cell, const std::filesystem::path& bin_dir);
+std::vector<std::string> twin_order_args(const CellConfig& cell, const std::string& order, const std::string& product,
+                                         const std::string& out, const std::string& sequence, const std::string& path,
+                                         const std::filesystem::path& state_dir, double wait_s = 30, bool quote = false);
 
 }  // namespace cellctl

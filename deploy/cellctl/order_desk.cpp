@@ -6,11 +6,16 @@ namespace cellctl {
 
 OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
                      int max_deaths)
-    : cell_(cell), store_(store), log_(std::move(log)), max_deaths_(max_deaths) {}
+    : cell_(cell),
+      store_(store),
+      log_(std::move(log)),
+      max_deaths_(max_deaths),
+      standby_(twin_standby_argv(cell, executable_dir()), cell.standby_twins, log_) {}
 
 OrderDesk::~OrderDesk() { interrupt_all(); }
 
 void OrderDesk::tend() {
+  standby_.tend();
   const auto now = std::chrono::steady_clock::now();
   std::vector<std::pair<std::string, int>> ended;  // order, its twin's exit code
   for (auto it = twins_.begin(); it != twins_.end();) {
@@ -59,9 +64,18 @@ void OrderDesk::tend() {
       const int attempt = store_.count_attempt(id);
       // Until the twin says more: one killed before it wrote a word counts as died.
       store_.set_order(id, "SUBMITTED", o.reason);
-      twins_[id] = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
-                                                                      cell_.state_folder(), 30, o.quote));
-      store_.journal("cellctl", "twin started", id, "attempt " + std::to_string(attempt));
+      const auto order_args = twin_order_args(cell_, id, o.product, o.out, o.sequence, o.path, cell_.state_folder(), 30, o.quote);
+      auto twin = standby_.take("twin-" + id, order_args);
+      const bool was_standing_by = twin != nullptr;
+      if (!twin) {
+        twin = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence,
+                                                                 o.path, cell_.state_folder(), 30, o.quote));
+      }
+      // The pid says which process is the order's twin (a standby one has no --order to see).
+      store_.journal("cellctl", "twin started", id,
+                     "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin->pid()) +
+                         (was_standing_by ? ", standing by" : ""));
+      twins_[id] = std::move(twin);
       if (attempt > 1) log_("order " + id + ": twin started again (attempt " + std::to_string(attempt) + ")");
     } catch (const std::exception& e) {
       store_.set_order(id, "FAILED", std::string("its twin cannot be started: ") + e.what(), 1);

@@ -7,6 +7,8 @@
 // records its order INTERRUPTED, and that costs the order nothing; a twin that died (killed,
 // crashed) counts, and after `max_deaths` of them the order fails with the reason. So does
 // one the cell stopped kMaxAttemptsPerDeath times as often: nothing loops for ever.
+// An order's twin is a standby one where one stands by (twin_pool.hpp); the journal's
+// "twin started" says its pid.
 
 #include <chrono>
 #include <functional>
@@ -16,6 +18,7 @@
 
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/processes.hpp"
+#include "deploy/cellctl/twin_pool.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -41,6 +44,7 @@ class OrderDesk {
   std::map<std::string, int> deaths_;  // order -> its twins that died (since this desk started)
   std::map<std::string, std::unique_ptr<Process>> twins_;                   // order -> its twin
   std::map<std::string, std::chrono::steady_clock::time_point> not_before_;  // order -> next start
+  TwinPool standby_;
 };
 
 }  // namespace cellctl

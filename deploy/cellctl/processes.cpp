@@ -3,9 +3,11 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -25,7 +27,7 @@ int exit_code_of(int status) {
 }  // namespace
 
 Process::Process(std::string name, const std::vector<std::string>& argv, const std::string& stdout_to,
-                 const std::string& stderr_to)
+                 const std::string& stderr_to, bool with_input)
     : name_(std::move(name)) {
   std::vector<std::string> copy = argv;
   std::vector<char*> args;
@@ -33,12 +35,25 @@ Process::Process(std::string name, const std::vector<std::string>& argv, const s
   args.push_back(nullptr);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
+  // A socket, not a pipe: a write to one whose reader died fails with EPIPE and no SIGPIPE
+  // (MSG_NOSIGNAL). Both ends close on exec; the child's copy on its stdin does not.
+  int input[2] = {-1, -1};
+  if (with_input && ::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, input) != 0) {
+    posix_spawn_file_actions_destroy(&actions);
+    throw std::runtime_error("cannot start " + argv[0] + ": no socket for its input");
+  }
+  if (with_input) posix_spawn_file_actions_adddup2(&actions, input[1], STDIN_FILENO);
   for (const auto& [fd, file] : {std::pair{STDOUT_FILENO, &stdout_to}, std::pair{STDERR_FILENO, &stderr_to}}) {
     if (!file->empty()) posix_spawn_file_actions_addopen(&actions, fd, file->c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   }
   const int spawned = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  if (with_input) {
+    ::close(input[1]);
+    input_ = input[0];
+  }
   if (spawned != 0) {
+    if (input_ >= 0) ::close(input_);
     pid_ = -1;
     throw std::runtime_error("cannot start " + argv[0]);
   }
@@ -46,6 +61,17 @@ Process::Process(std::string name, const std::vector<std::string>& argv, const s
 
 Process::~Process() {
   if (pid_ > 0 && exit_code_ < 0) stop(std::chrono::milliseconds(2000));
+  if (input_ >= 0) ::close(input_);
+}
+
+bool Process::write_input(const std::string& text) {
+  for (std::size_t sent = 0; sent < text.size();) {
+    const ssize_t n = input_ < 0 ? -1 : ::send(input_, text.data() + sent, text.size() - sent, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    sent += static_cast<std::size_t>(n);
+  }
+  return true;
 }
 
 int Process::poll() {

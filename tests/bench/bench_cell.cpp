@@ -4,7 +4,8 @@
 //  2. a command's round trip from a sender to a resource process (a buffer: commands topic,
 //     function-block resource, life cycle, command events) until SUCCEEDED;
 //  3. the time from starting a twin to its first status, and to it having planned, heard
-//     cell-sim answer and begun virtual assembly (over --launches twin starts);
+//     cell-sim answer and begun virtual assembly (over --launches twin starts), and the
+//     same from handing an order to a standby twin (deploy/cellctl/twin_pool.hpp);
 //  4. 1 and 2 again while `cellctl run` assembles 10 orders on the default cell.
 // Prints p50 and p99 of each. Run: build/release/bin/bench_cell [--rounds N] [--launches N]
 //   (internal: bench_cell --echo DOMAIN is the ping-pong's other side)
@@ -16,12 +17,15 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "commandsPubSubTypes.h"
 #include "ordersPubSubTypes.h"
+#include "deploy/cellctl/twin_pool.hpp"
 #include "services/dds/endpoints.hpp"
 #include "tests/bench/bench_support.hpp"
 #include "tests/support/child_process.hpp"
@@ -72,7 +76,9 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
   });
 }
 
-// With cell-sim and a station running (the twin needs both before virtual assembly).
+// With cell-sim and a station running (the twin needs both before virtual assembly), `rounds`
+// twins started with their orders (cold), then `rounds` standby twins (cellctl up's: started
+// ahead, here 1.5 s before their order, the order then written to their input).
 void twin_start(int domain, int rounds) {
   test::ChildProcess sim({CELL_SIM_EXE, "--domain", std::to_string(domain)}, "/dev/null");
   test::ChildProcess station({STATION_EXE, "--domain", std::to_string(domain)}, "/dev/null");
@@ -92,35 +98,54 @@ void twin_start(int domain, int rounds) {
         changed.notify_all();
       },
       {}, qos);
-  std::vector<double> first_status, planned;
-  for (int i = 0; i < rounds; ++i) {
-    const std::string order = "bench-" + std::to_string(i);
-    const auto start = Clock::now();
-    test::ChildProcess twin({TWIN_EXE, "--domain", std::to_string(domain), "--order", order, "--product",
-                             std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "--out", "/tmp/bench-twin",
-                             "--wait", "5", "--quiet"},
-                            "/dev/null");
-    std::unique_lock<std::mutex> lock(mutex);
-    if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
-      first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+  const std::vector<std::string> cell_args{TWIN_EXE, "--domain", std::to_string(domain), "--quiet"};
+  const auto order_args = [](const std::string& order) {
+    return std::vector<std::string>{"--order", order, "--product", std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml",
+                                    "--out", "/tmp/bench-twin", "--wait", "5"};
+  };
+  for (const bool standing_by : {false, true}) {
+    std::vector<double> first_status, planned;
+    auto standby_args = cell_args;
+    standby_args.push_back("--standby");
+    cellctl::TwinPool pool(standby_args, standing_by ? 1 : 0);
+    for (int i = 0; i < rounds; ++i) {
+      const std::string order = std::string(standing_by ? "standby-" : "cold-") + std::to_string(i);
+      std::unique_ptr<cellctl::Process> twin;
+      if (standing_by) std::this_thread::sleep_for(1500ms);
+      const auto start = Clock::now();
+      if (standing_by) {
+        twin = pool.take("twin-" + order, order_args(order));
+        if (!twin) throw std::runtime_error("no standby twin");
+        pool.tend();
+      } else {
+        auto argv = cell_args;
+        const auto more = order_args(order);
+        argv.insert(argv.end(), more.begin(), more.end());
+        twin = std::make_unique<cellctl::Process>("twin-" + order, argv, "/dev/null");
+      }
+      std::unique_lock<std::mutex> lock(mutex);
+      if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
+        first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+      }
+      // Planned, cell-sim answered, a station known: virtual assembly begins.
+      const auto negotiating = [&] {
+        const auto it = seen.find(order);
+        return it != seen.end() && it->second.state() >= cell::VIRTUAL_ASSEMBLY;
+      };
+      if (changed.wait_for(lock, 10s, negotiating)) {
+        planned.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+      }
+      lock.unlock();
+      twin->stop();
     }
-    // Planned, cell-sim answered, a station known: virtual assembly begins.
-    const auto negotiating = [&] {
-      const auto it = seen.find(order);
-      return it != seen.end() && it->second.state() >= cell::VIRTUAL_ASSEMBLY;
-    };
-    if (changed.wait_for(lock, 10s, negotiating)) {
-      planned.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-    }
-    lock.unlock();
-    twin.stop();
+    const std::string how = standing_by ? "standby twin" : "twin start";
+    report(how + " to its first status (Cranfield)", first_status);
+    report(how + " to planned, cell-sim answered, virtual assembly begun (Cranfield)", planned);
+    std::cout << "  slowest " << *std::max_element(planned.begin(), planned.end()) / 1000 << " ms; "
+              << rounds - planned.size() << " never got there within 10 s" << std::endl;
   }
   station.stop();
   sim.stop();
-  report("twin start to its first status (Cranfield)", first_status);
-  report("twin start to planned, cell-sim answered, virtual assembly begun (Cranfield)", planned);
-  std::cout << "  slowest start " << *std::max_element(planned.begin(), planned.end()) / 1000 << " ms; "
-            << rounds - planned.size() << " starts never got there within 10 s" << std::endl;
 }
 
 // Gives from the buffer "bench-buffer", hired first as a twin hires it.

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
 
 namespace {
@@ -266,6 +267,17 @@ TEST_CASE("cell up: a bad order and one with a subassembly fail alone, the cell 
   INFO(read_text(dir / "good.log") << read_text(dir / "up.log"));
   CHECK(good == 0);
 
+  // Each twin the desk started was one standing by (it starts the next as one is taken); the
+  // bad order may have come before the cell was up, and then its twin ran in cellctl submit.
+  int started = 0, standing_by = 0;
+  for (const auto& e : state::CellStore(dir / "state").journal_since(0)) {
+    if (e.event != "twin started") continue;
+    ++started;
+    standing_by += e.detail.find("standing by") != std::string::npos;
+  }
+  CHECK(started >= 2);
+  CHECK(standing_by == started);
+
   CHECK(cellctl({"status", "--domain", domain}, dir / "status.log", 30s) == 0);
   const std::string status = read_text(dir / "status.log");
   INFO(status);
@@ -309,6 +321,41 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
     INFO(read_text(dir / "early.log") << read_text(dir / "up.log"));
     CHECK(code == 0);
     CHECK(up.stop(20s) == 0);
+  }
+}
+
+TEST_CASE("a standby twin: it reads its order from its input, and refuses a bad one", "[process][cell]") {
+  const fs::path dir = scratch("standby-twin");
+  const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+  // `input` fed to a standby twin on domain 189 (no cell there); its exit code, its output in `log`.
+  const auto standby = [&](const std::string& input, const fs::path& log, const std::string& more = "") {
+    test::ChildProcess twin({"/bin/sh", "-c", "{ " + input + "; } | " + TWIN_EXE + " --domain 189 --standby " + more},
+                            log.string());
+    return twin.wait_for_exit(30s);
+  };
+  SECTION("its order comes on its input: it works as one started with it") {
+    const int code = standby("printf '%s\\n' --order waiting --product " + product + " --out " + (dir / "o").string() +
+                                 " --wait 2; echo",
+                             dir / "order.log");
+    const std::string log = read_text(dir / "order.log");
+    INFO(log);
+    CHECK(code == 1);
+    CHECK(log.find("[waiting] SUBMITTED") != std::string::npos);
+    CHECK(log.find("did not appear within 2 s") != std::string::npos);
+  }
+  SECTION("no order comes (its input ends): it ends quietly") {
+    CHECK(standby("true", dir / "none.log") == 0);
+    CHECK(read_text(dir / "none.log").empty());
+  }
+  SECTION("an order without a product, or with an unknown option: refused, with what is wrong") {
+    CHECK(standby("printf '%s\\n' --order half; echo", dir / "half.log") == 2);
+    CHECK(read_text(dir / "half.log").find("needs --order and --product") != std::string::npos);
+    CHECK(standby("printf '%s\\n' --order odd --bogus; echo", dir / "odd.log") != 0);
+    CHECK(read_text(dir / "odd.log").find("--bogus") != std::string::npos);
+  }
+  SECTION("its order is not on its command line") {
+    CHECK(standby("true", dir / "argv.log", "--order x") == 2);
+    CHECK(read_text(dir / "argv.log").find("reads its order from standard input") != std::string::npos);
   }
 }
 

@@ -11,6 +11,7 @@
 
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/order_twins.hpp"
 
 namespace {
 
@@ -174,7 +175,7 @@ TEST_CASE("a twin killed during physical assembly is started again and finishes 
                             (dir / "submit.log").string());
   const auto placed = wait_for_placed(state_dir, "tower", 3);
   REQUIRE(placed.size() >= 3);
-  const pid_t twin = test::child_with_argument(up.pid(), "tower");
+  const pid_t twin = test::twin_of(state::CellStore(state_dir), "tower");
   REQUIRE(twin > 0);
   ::kill(twin, SIGKILL);
   const int code = submit.wait_for_exit(150s);

@@ -68,7 +68,7 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
 
   // cellctl up dies hard: its processes end with it (they asked for SIGTERM when their parent goes).
   const auto children = test::children_of(up->pid());
-  REQUIRE(children.size() == 5);
+  REQUIRE(children.size() == 6);  // cell-sim, the station, the robot, two buffers, a standby twin
   up->kill_hard();
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   const auto any_left = [&] {

@@ -27,6 +27,7 @@
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/order_twins.hpp"
 
 namespace test {
 
@@ -77,15 +78,24 @@ inline std::vector<std::string> processes_on_domain(int domain) {
 
 namespace chaos_detail {
 
-// What identifies a cell process across restarts: a twin's order, a resource's id, or its name.
-inline std::string identity_of(pid_t pid, const std::string& name) {
+// What identifies a cell process across restarts: a twin's order (on its command line, or for
+// a standby twin in the journal), a resource's id, or its name.
+inline std::string identity_of(pid_t pid, const std::string& name, const state::CellStore& store) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline", std::ios::binary);
   std::vector<std::string> args;
   for (std::string a; std::getline(in, a, '\0');) args.push_back(a);
   for (std::size_t i = 0; i + 1 < args.size(); ++i) {
     if (args[i] == "--order" || args[i] == "--id") return args[i + 1];
   }
-  return name;
+  const std::string order = order_of_twin(store, pid);
+  return order.empty() ? name : order;
+}
+
+// The live process of cellctl up `up` that `identity` names, or 0.
+inline pid_t process_of(pid_t up, const std::string& identity, const state::CellStore& store) {
+  if (const pid_t pid = child_with_argument(up, identity)) return pid;
+  const pid_t twin = twin_of(store, identity);
+  return twin > 0 && is_running(twin) ? twin : 0;
 }
 
 // The ledger and the orders' states as one string: it changes when anything moved.
@@ -167,7 +177,7 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
     const std::string now_print = chaos_detail::fingerprint(store);
     for (auto it = pending.begin(); it != pending.end();) {
       if (!it->back) {
-        const pid_t pid = it->is_up ? (is_running(up->pid()) ? up->pid() : 0) : child_with_argument(up->pid(), it->identity);
+        const pid_t pid = it->is_up ? (is_running(up->pid()) ? up->pid() : 0) : chaos_detail::process_of(up->pid(), it->identity, store);
         const bool order_ended = [&] {
           for (const auto& order : store.orders()) {
             if (order.order == it->identity) return order.ended();
@@ -209,7 +219,7 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
         up = start_up();
       } else if (const auto children = children_of(up->pid()); !children.empty()) {
         const auto& [name, pid] = children[random() % children.size()];
-        const std::string identity = chaos_detail::identity_of(pid, name);
+        const std::string identity = chaos_detail::identity_of(pid, name, store);
         ::kill(pid, SIGKILL);
         r.kills.push_back("t=" + std::to_string(seconds()) + " " + identity + " (pid " + std::to_string(pid) + ")");
         pending.push_back({Clock::now(), identity, pid, false, false, ""});

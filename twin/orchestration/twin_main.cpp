@@ -4,6 +4,8 @@
 // noticed by the resources it reserved) and writes the plan and the animation.
 //   twin --domain 42 --order o1 --product deploy/products/cranfield/cranfield.aml --out out/o1
 // With --quote it assembles virtually only and writes quote.json (docs/quotes.md).
+// With --standby it joins the cell first and reads the order's options from standard input,
+// one per line, ended by an empty line (cellctl up's standby twins: docs/order-desk.md).
 // Exit codes: 0 assembled (or quoted, feasible or not), 1 the order failed, 2 bad input.
 
 #include <algorithm>
@@ -16,6 +18,9 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+
+#include <poll.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -69,15 +74,17 @@ struct Options {
 
 class TwinProcess {
  public:
+  // Joins the cell: nothing here depends on the order, which a standby twin learns later.
   explicit TwinProcess(const Options& o)
-      : options_(o), participant_(dds::make_participant("twin-" + o.order, o.dds)), clock_(participant_) {
+      : options_(o),
+        participant_(dds::make_participant(o.order.empty() ? "twin-standby" : "twin-" + o.order, o.dds)),
+        clock_(participant_) {
     dds::QosSettings qos;
     qos.liveliness_lease_s = o.lease_s;
     status_ = std::make_unique<dds::Writer<cell::OrderStatus, cell::OrderStatusPubSubType>>(
         participant_, "cell/orders/status", TopicKind::state, qos);
     result_ = std::make_unique<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>>(
         participant_, "cell/orders/result", TopicKind::state, qos);
-    if (!o.state_dir.empty()) store_ = std::make_unique<state::CellStore>(o.state_dir);
   }
 
   void status(const std::string& state, const std::string& message, double progress) {
@@ -108,8 +115,10 @@ class TwinProcess {
     result_->write(r);
   }
 
-  // Plans, then orchestrates; returns the exit code.
-  int run() {
+  // Plans `order`, then orchestrates it; returns the exit code.
+  int run(const Options& order) {
+    options_ = order;
+    if (!options_.state_dir.empty()) store_ = std::make_unique<state::CellStore>(options_.state_dir);
     status("SUBMITTED", options_.product, 0);
     if (store_ && !take_up()) return end_with(1, "the work of its earlier twin did not end within 60 s");
     sim::MeshCache meshes;
@@ -427,28 +436,27 @@ class TwinProcess {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  CLI::App app{"twin: the digital twin of one order"};
-  Options o;
-  bool all_interfaces = false;
-  dds::add_dds_options(app, o.dds, all_interfaces);
-  app.add_option("--order", o.order, "Order id")->required();
-  app.add_option("--product", o.product, "The product's AutomationML file")->required();
+namespace {
+
+// What one order is: on the command line, or for a standby twin on its standard input.
+void add_order_options(CLI::App& app, Options& o, std::vector<std::string>& rates) {
+  app.add_option("--order", o.order, "Order id");
+  app.add_option("--product", o.product, "The product's AutomationML file");
   app.add_option("--out", o.out, "Folder for report.html, plan.json and animation.gltf");
   app.add_option("--sequence", o.sequence, "Sequence planner")->check(CLI::IsMember({"paper", "search"}));
   app.add_option("--path", o.path, "Path planner")->check(CLI::IsMember({"linear", "ompl"}));
   app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);
-  app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
   dds::add_state_option(app, o.state_dir);
   dds::add_gripper_options(app, o.gripper);
   app.add_flag("--quote", o.quote, "Assemble virtually only and answer with quote.json: time and cost here, findings");
   app.add_option("--setup-cost", o.rates.setup_cost, "Quote: the fixed cost of an order")->check(CLI::NonNegativeNumber);
-  std::vector<std::string> rates;
   app.add_option("--cost-per-hour", rates, "Quote: RESOURCE=COST, for each hour the order uses the resource");
   app.add_option("--currency", o.rates.currency, "Quote: the currency of the costs");
-  app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
-  app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
-  CLI11_PARSE(app, argc, argv);
+}
+
+// After parsing: the rates (CLI11 takes a map option only as two words per entry) and the
+// options an order cannot go without. An error's text, or empty.
+std::string finish_order_options(const std::vector<std::string>& rates, Options& o) {
   for (const auto& r : rates) {
     const auto eq = r.find('=');
     double cost = -1;
@@ -458,20 +466,83 @@ int main(int argc, char** argv) {
       if (used != r.size() - eq - 1) cost = -1;
     } catch (const std::exception&) {
     }
-    if (!(cost >= 0 && std::isfinite(cost))) {
-      std::cerr << "error: --cost-per-hour " << r << ": give RESOURCE=COST, a number >= 0\n";
-      return 2;
-    }
+    if (!(cost >= 0 && std::isfinite(cost))) return "--cost-per-hour " + r + ": give RESOURCE=COST, a number >= 0";
     o.rates.per_hour[r.substr(0, eq)] = cost;
   }
+  if (o.order.empty() || o.product.empty()) return "an order needs --order and --product";
+  return "";
+}
+
+// A standby twin's order: its options from standard input, one per line, up to an empty line.
+// False when the input ends first or the twin is stopped (no order came: nothing to do).
+bool read_standby_order(std::vector<std::string>& args) {
+  std::string line;
+  while (running) {
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&in, 1, 100) <= 0) continue;  // a time-out, or a signal: look at `running`
+    char c = 0;
+    if (::read(STDIN_FILENO, &c, 1) != 1) return false;
+    if (c != '\n') {
+      line += c;
+    } else if (line.empty()) {
+      return true;
+    } else {
+      args.push_back(std::move(line));
+      line.clear();
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"twin: the digital twin of one order"};
+  Options o;
+  bool all_interfaces = false, standby = false;
+  std::vector<std::string> rates;
+  dds::add_dds_options(app, o.dds, all_interfaces);
+  app.add_option("--lease", o.lease_s, "Liveliness lease of the order's status, s")->check(CLI::PositiveNumber);
+  app.add_flag("--verbose", o.verbose, "Print every command, cell-sim request and answer");
+  app.add_flag("--quiet", o.quiet, "Do not print the order's status (whoever started the twin shows it)");
+  app.add_flag("--standby", standby,
+               "Join the cell now, then read the order's options (--order, --product, ...) from standard input, "
+               "one per line, ended by an empty line");
+  add_order_options(app, o, rates);
+  CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(o.dds, all_interfaces);
   if (o.dds.security.identity.empty()) o.dds.security.identity = "twin";  // every twin has the role's identity
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   services::stop_with_parent();
+  if (standby && !o.order.empty()) {
+    std::cerr << "error: a standby twin reads its order from standard input, not --order\n";
+    return 2;
+  }
+  const std::string bad = standby ? "" : finish_order_options(rates, o);
+  if (!bad.empty()) {
+    std::cerr << "error: " << bad << '\n';
+    return 2;
+  }
   try {
     TwinProcess twin(o);
-    return twin.run();
+    if (standby) {
+      std::vector<std::string> args;
+      if (!read_standby_order(args)) return 0;
+      CLI::App order_app{"the standby twin's order"};
+      add_order_options(order_app, o, rates);
+      std::reverse(args.begin(), args.end());  // CLI11 takes a vector last argument first
+      try {
+        order_app.parse(args);
+      } catch (const CLI::ParseError& e) {
+        return order_app.exit(e);
+      }
+      if (const std::string why = finish_order_options(rates, o); !why.empty()) {
+        std::cerr << "error: " << why << '\n';
+        return 2;
+      }
+    }
+    return twin.run(o);
   } catch (const std::exception& e) {
     std::cerr << "error: twin " << o.order << ": " << e.what() << '\n';
     return 1;
