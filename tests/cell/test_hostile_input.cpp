@@ -4,6 +4,7 @@
 // still be assembled. Every process is ended by its id; every wait is bounded.
 
 #include <condition_variable>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -217,6 +218,25 @@ class HostileCell {
     return out;
   }
 
+  // rss() once no process's has changed by 1 MB or more in a second (at most 60 s): a
+  // process still starting (the standby twin joins the cell after the resources, slowly
+  // under ThreadSanitizer) is not measured while it grows.
+  std::map<std::string, long> settled_rss() const {
+    auto last = rss();
+    for (int i = 0; i < 60; ++i) {
+      std::this_thread::sleep_for(1s);
+      auto now = rss();
+      bool settled = now.size() == last.size();
+      for (const auto& [name, kb] : now) {
+        const auto it = last.find(name);
+        settled = settled && it != last.end() && std::abs(kb - it->second) < 1024;
+      }
+      last = std::move(now);
+      if (settled) break;
+    }
+    return last;
+  }
+
  private:
   template <class F>
   void add(F f) {
@@ -339,8 +359,7 @@ TEST_CASE("hostile: a grip of negative, NaN or too wide an opening is rejected",
 TEST_CASE("hostile: a path of 1,000,000 waypoints is dropped by DDS, and no process keeps the memory",
           "[process][hostile]") {
   HostileCell cell(214, "huge-path");
-  std::this_thread::sleep_for(2s);  // the cell settles
-  const auto before = cell.rss();
+  const auto before = cell.settled_rss();
   {
     // The intruder's own writer, whose buffers grow to whatever it writes.
     namespace fdds = eprosima::fastdds::dds;
@@ -455,8 +474,7 @@ TEST_CASE("hostile: cell-sim refuses an intruder's changes to an order's parts, 
 TEST_CASE("hostile: a burst of 10,000 commands: each gets a final event, the station lives and gives its memory back",
           "[process][hostile]") {
   HostileCell cell(219, "burst");
-  std::this_thread::sleep_for(2s);
-  const long before = cell.rss().at("station");
+  const long before = cell.settled_rss().at("station");
   std::vector<std::string> written;
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < 10000; ++i) {
@@ -478,7 +496,9 @@ TEST_CASE("hostile: a burst of 10,000 commands: each gets a final event, the sta
   if (kUnderSanitizer) {
     WARN("memory not checked under a sanitizer");
   } else {
-    CHECK(after <= before * 1.1);
+    // What stays is the allocator's and DDS's, not the burst's: 1.8-2.8 MB after 10,000
+    // commands and after 30,000 alike; before the command queue was bounded, 33 MB.
+    CHECK(after <= before + 5 * 1024);
   }
   CHECK(cell.order_succeeds("ok1"));
 }
