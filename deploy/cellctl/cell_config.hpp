@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "services/dds/participant.hpp"
+#include "services/dds/participant_settings.hpp"
 #include "services/node/gripper.hpp"
 
 namespace cellctl {

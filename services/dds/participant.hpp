@@ -10,19 +10,10 @@
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 
+#include "services/dds/participant_settings.hpp"
 #include "services/dds/security.hpp"
 
 namespace dds {
-
-struct ParticipantSettings {
-  int domain_id = 0;
-  bool localhost_only = true;
-  SecuritySettings security;  // off unless security.dir is set (services/dds/security.hpp)
-  // Without localhost_only: the host's addresses to use, and other hosts' to look for
-  // participants at (unicast discovery); both empty: every interface, Fast DDS's default
-  // discovery.
-  std::vector<std::string> interfaces{}, peers{};
-};
 
 // Deletes the participant and everything it created when the last owner lets go.
 using ParticipantPtr = std::shared_ptr<eprosima::fastdds::dds::DomainParticipant>;

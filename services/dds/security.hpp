@@ -18,12 +18,9 @@
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
-namespace dds {
+#include "services/dds/participant_settings.hpp"
 
-struct SecuritySettings {
-  std::filesystem::path dir;  // empty: security off
-  std::string identity;       // the folder under DIR/identities; empty: the participant's name
-};
+namespace dds {
 
 struct IdentityFiles {
   std::filesystem::path ca_cert, governance, cert, key, permissions;
