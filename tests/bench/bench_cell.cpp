@@ -25,9 +25,9 @@
 
 #include "commandsPubSubTypes.h"
 #include "ordersPubSubTypes.h"
-#include "deploy/cellctl/twin_pool.hpp"
 #include "services/dds/endpoints.hpp"
 #include "tests/bench/bench_support.hpp"
+#include "tests/bench/twin_launches.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/hire.hpp"
 
@@ -76,74 +76,15 @@ std::vector<double> round_trips(const dds::ParticipantPtr& participant, const st
   });
 }
 
-// With cell-sim and a station running (the twin needs both before virtual assembly), `rounds`
-// twins started with their orders (cold), then `rounds` standby twins (cellctl up's: started
-// ahead, here 1.5 s before their order, the order then written to their input).
+// With cell-sim and a station running (the twin needs both before virtual assembly): twins
+// started with their orders, then standby twins handed theirs.
 void twin_start(int domain, int rounds) {
   test::ChildProcess sim({CELL_SIM_EXE, "--domain", std::to_string(domain)}, "/dev/null");
   test::ChildProcess station({STATION_EXE, "--domain", std::to_string(domain)}, "/dev/null");
-  auto participant = dds::make_participant("bench-observer", {domain, true, {}});
-  std::mutex mutex;
-  std::condition_variable changed;
-  // The latest status per order (keep last 1: statuses in quick succession may coalesce).
-  std::map<std::string, cell::OrderStatus> seen;
-  dds::QosSettings qos;
-  dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType> statuses(
-      participant, "cell/orders/status", dds::TopicKind::state,
-      [&](const cell::OrderStatus& s) {
-        {
-          std::lock_guard<std::mutex> lock(mutex);
-          seen[s.order_id().to_string()] = s;
-        }
-        changed.notify_all();
-      },
-      {}, qos);
-  const std::vector<std::string> cell_args{TWIN_EXE, "--domain", std::to_string(domain), "--quiet"};
-  const auto order_args = [](const std::string& order) {
-    return std::vector<std::string>{"--order", order, "--product", std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml",
-                                    "--out", "/tmp/bench-twin", "--wait", "5"};
-  };
-  for (const bool standing_by : {false, true}) {
-    std::vector<double> first_status, planned;
-    auto standby_args = cell_args;
-    standby_args.push_back("--standby");
-    cellctl::TwinPool pool(standby_args, standing_by ? 1 : 0);
-    for (int i = 0; i < rounds; ++i) {
-      const std::string order = std::string(standing_by ? "standby-" : "cold-") + std::to_string(i);
-      std::unique_ptr<cellctl::Process> twin;
-      if (standing_by) std::this_thread::sleep_for(1500ms);
-      const auto start = Clock::now();
-      if (standing_by) {
-        twin = pool.take("twin-" + order, order_args(order));
-        if (!twin) throw std::runtime_error("no standby twin");
-        pool.tend();
-      } else {
-        auto argv = cell_args;
-        const auto more = order_args(order);
-        argv.insert(argv.end(), more.begin(), more.end());
-        twin = std::make_unique<cellctl::Process>("twin-" + order, argv, "/dev/null");
-      }
-      std::unique_lock<std::mutex> lock(mutex);
-      if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
-        first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-      }
-      // Planned, cell-sim answered, a station known: virtual assembly begins.
-      const auto negotiating = [&] {
-        const auto it = seen.find(order);
-        return it != seen.end() && it->second.state() >= cell::VIRTUAL_ASSEMBLY;
-      };
-      if (changed.wait_for(lock, 10s, negotiating)) {
-        planned.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-      }
-      lock.unlock();
-      twin->stop();
-    }
-    const std::string how = standing_by ? "standby twin" : "twin start";
-    report(how + " to its first status (Cranfield)", first_status);
-    report(how + " to planned, cell-sim answered, virtual assembly begun (Cranfield)", planned);
-    std::cout << "  slowest " << *std::max_element(planned.begin(), planned.end()) / 1000 << " ms; "
-              << rounds - planned.size() << " never got there within 10 s" << std::endl;
-  }
+  auto observer = dds::make_participant("bench-observer", {domain, true, {}});
+  const std::vector<std::string> twin{TWIN_EXE, "--domain", std::to_string(domain), "--quiet"};
+  report("twin start", bench::twin_launches(observer, twin, rounds, false, "bench"));
+  report("standby twin", bench::twin_launches(observer, twin, rounds, true, "bench"));
   station.stop();
   sim.stop();
 }

@@ -2,7 +2,7 @@
 //  1. a command's round trip to a buffer process until SUCCEEDED (hired as a twin hires it,
 //     sent as the mobile robot sends gives: the identities `twin` and `mobile-robot-1`);
 //  2. a twin's start to its first status, and to virtual assembly begun (Cranfield, with
-//     cell-sim and a station running);
+//     cell-sim and a station running), started with its order and as a standby twin;
 //  3. `cellctl run` of Cranfield on the default cell, wall time from start to end.
 // Run: build/release/bin/bench_security [--rounds N] [--launches N] [--runs N]
 
@@ -13,6 +13,7 @@
 
 #include "ordersPubSubTypes.h"
 #include "tests/bench/bench_support.hpp"
+#include "tests/bench/twin_launches.hpp"
 #include "tests/support/cell_test.hpp"
 #include "tests/support/hire.hpp"
 
@@ -72,37 +73,9 @@ void twin_starts(const Mode& m, int launches) {
   test::ChildProcess sim(m.with({CELL_SIM_EXE, "--domain", domain}), "/dev/null");
   test::ChildProcess station(m.with({STATION_EXE, "--domain", domain, "--id", "station-1"}), "/dev/null");
   auto observer = dds::make_participant("bench-observer", m.as("cellctl"));
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::map<std::string, cell::OrderStatus> seen;
-  dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType> statuses(
-      observer, "cell/orders/status", dds::TopicKind::state, [&](const cell::OrderStatus& s) {
-        {
-          std::lock_guard<std::mutex> lock(mutex);
-          seen[s.order_id().to_string()] = s;
-        }
-        changed.notify_all();
-      });
-  std::vector<double> first_status, begun;
-  for (int i = 0; i < launches; ++i) {
-    const std::string order = "bench-" + m.name + "-" + std::to_string(i);
-    const auto start = Clock::now();
-    test::ChildProcess twin(m.with({TWIN_EXE, "--domain", domain, "--order", order, "--product",
-                                    std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", "--out", "/tmp/bench-security-twin",
-                                    "--wait", "5", "--quiet"}),
-                            "/dev/null");
-    std::unique_lock<std::mutex> lock(mutex);
-    if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
-      first_status.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-    }
-    if (changed.wait_for(lock, 10s, [&] { return seen.count(order) && seen[order].state() >= cell::VIRTUAL_ASSEMBLY; })) {
-      begun.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
-    }
-    lock.unlock();
-    twin.stop();
-  }
-  report("security " + m.name + ": twin start to its first status (Cranfield)", first_status);
-  report("security " + m.name + ": twin start to virtual assembly begun (Cranfield)", begun);
+  const auto twin = m.with({TWIN_EXE, "--domain", domain, "--quiet"});
+  report("security " + m.name + ": twin start", bench::twin_launches(observer, twin, launches, false, m.name));
+  report("security " + m.name + ": standby twin", bench::twin_launches(observer, twin, launches, true, m.name));
   station.stop();
   sim.stop();
 }
