@@ -2,7 +2,7 @@
 # Installs what is missing, then builds and runs the whole test suite twice: a Release
 # build, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer; then the
 # block, DDS and process tests (labels blocks, dds, processes) once more under
-# ThreadSanitizer; then each libFuzzer target for 60 s (deploy/fuzz.sh).
+# ThreadSanitizer; then each libFuzzer target for 30 s (deploy/fuzz.sh; longer runs by hand).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh
@@ -31,4 +31,4 @@ fastdds shm clean >/dev/null 2>&1 || true
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
   ctest --test-dir build/tsan --output-on-failure -j "$jobs" -L "blocks|dds|processes"
 
-bash deploy/fuzz.sh 60
+bash deploy/fuzz.sh 30
