@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
     std::cerr << "error: cannot run " << full << ": " << std::strerror(errno) << '\n';
     return 1;
   }
-  CLI::App app{"cellctl: plan and run product orders on an agile assembly cell"};
+  CLI::App app{cellctl::kDescription};
   app.require_subcommand(1);
   int exit_code = 0;
   cellctl::add_describe_command(app, exit_code);

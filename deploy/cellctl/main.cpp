@@ -12,7 +12,7 @@
 #include "deploy/cellctl/run_app.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"cellctl: plan and run product orders on an agile assembly cell"};
+  CLI::App app{cellctl::kDescription};
   app.require_subcommand(1);
   int exit_code = 0;
   cellctl::add_describe_command(app, exit_code);

@@ -7,6 +7,15 @@
 
 namespace cellctl {
 
+namespace {
+
+int fail(const std::exception& e, int code) {
+  std::cerr << "error: " << e.what() << '\n';
+  return code;
+}
+
+}  // namespace
+
 int run_app(CLI::App& app, int argc, char** argv, const int& exit_code) {
   try {
     app.parse(argc, argv);
@@ -16,14 +25,11 @@ int run_app(CLI::App& app, int argc, char** argv, const int& exit_code) {
     app.exit(e);
     return 2;
   } catch (const ConfigError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
+    return fail(e, 2);
   } catch (const twin::DescriptionError& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 2;
+    return fail(e, 2);
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << '\n';
-    return 1;
+    return fail(e, 1);
   }
   return exit_code;
 }

@@ -7,6 +7,9 @@
 
 namespace cellctl {
 
+// What `cellctl --help` says the program is, in both executables.
+inline constexpr const char* kDescription = "cellctl: plan and run product orders on an agile assembly cell";
+
 int run_app(CLI::App& app, int argc, char** argv, const int& exit_code);
 
 }  // namespace cellctl

@@ -13,18 +13,14 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <csignal>
 #include <cstring>
 #include <iostream>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "commandsPubSubTypes.h"
-#include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "tests/bench/bench_support.hpp"
 #include "tests/bench/twin_launches.hpp"

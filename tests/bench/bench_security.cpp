@@ -9,9 +9,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <map>
 
-#include "ordersPubSubTypes.h"
+#include "commandsPubSubTypes.h"
 #include "tests/bench/bench_support.hpp"
 #include "tests/bench/twin_launches.hpp"
 #include "tests/support/cell_test.hpp"
