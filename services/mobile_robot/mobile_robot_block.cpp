@@ -6,13 +6,16 @@
 
 namespace fb {
 
-MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers home, double speed)
-    : DeviceBlock(std::move(name), id, {"fetch"}, "INIT"), sim_(id), speed_(speed), work_ends_at_(home) {
+MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers home, double speed,
+                                   std::chrono::milliseconds resend_give_after)
+    : DeviceBlock(std::move(name), id, {"fetch"}, "INIT"), sim_(id), speed_(speed), work_ends_at_(home),
+      resend_give_after_(resend_give_after) {
   declare_input("INIT");
   declare_input("AWARDED", {"sources", "station"});
   declare_input("PLACE", {"resource_id", "dock"});
   declare_input("SIM_REPLY", {"request_id", "ok"});
   declare_input("GIVE_EVENT", {"command_id", "state", "reason"});
+  declare_input("TICK");
   declare_output("SIM", {"request_id", "kind", "body_id"});
   declare_output("GIVE", {"command_id", "resource_id", "operation", "part_type"});
 
@@ -67,7 +70,9 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   transition("TO_SOURCE", "SIM_REPLY", "WAIT_GIVE", [this, account](const Data& reply) {
     account(reply);
     give_id_ = get<std::string>(fetch_, "command_id") + "/give";
-    emit("GIVE", {{"command_id", give_id_},
+    give_heard_ = false;
+    give_sent_at_ = std::chrono::steady_clock::now();
+    give_ = {{"command_id", give_id_},
                   {"resource_id", fetch_.at("source")},
                   {"order_id", fetch_.at("order_id")},
                   {"award", get_or<std::string>(fetch_, "source_award", "")},
@@ -75,7 +80,8 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
                   {"part", fetch_.at("part")},
                   {"part_type", fetch_.at("part_type")},
                   {"destination", resource_id()},  // who takes the part: the buffer's record says so
-                  {"sim_time", get<double>(reply, "end_time")}});
+                  {"sim_time", get<double>(reply, "end_time")}};
+    emit("GIVE", give_);
   }, arrived);
   transition("TO_SOURCE", "SIM_REPLY", "READY", fail, answered);
   transition("WAIT_GIVE", "GIVE_EVENT", "TO_DESTINATION", [this](const Data&) {
@@ -84,6 +90,15 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   transition("WAIT_GIVE", "GIVE_EVENT", "READY", [this](const Data& d) {
     emit("FAIL", {{"reason", get<std::string>(d, "reason")}, {"distance", distance_}, {"duration", moving_}});
   }, [give_answer](const Data& d) { return give_answer("aborted")(d) || give_answer("rejected")(d); });
+  transition("WAIT_GIVE", "GIVE_EVENT", "WAIT_GIVE", [this](const Data&) { give_heard_ = true; },
+             [this](const Data& d) { return get<std::string>(d, "command_id") == give_id_; });
+  // A give the buffer never heard (written while a buffer that restarted was not matched
+  // again yet: commands are not kept for readers that come later) goes again; the buffer
+  // carries out a command id once, and answers a repeat with its last event.
+  transition("WAIT_GIVE", "TICK", "WAIT_GIVE", [this](const Data&) {
+    give_sent_at_ = std::chrono::steady_clock::now();
+    emit("GIVE", give_);
+  }, [this](const Data&) { return !give_heard_ && std::chrono::steady_clock::now() - give_sent_at_ >= resend_give_after_; });
   transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, account](const Data& reply) {
     if (store()) {
       store()->deliver(get_or<std::string>(fetch_, "order_id", ""), get<std::string>(fetch_, "part"),

@@ -10,8 +10,10 @@
 //     -> GIVE_EVENT succeeded -> SIM move to the destination's dock carrying the part -> DONE
 //   PLACE (resource_id, dock): where a resource hands parts over
 //   AWARDED (sources, station): a batch of fetches it was hired for; it will end there
+//   TICK (wall time, from its node): a give that no event answered in time is sent again
 // estimate(): how long a batch would take from where its work taken on so far ends.
 
+#include <chrono>
 #include <map>
 
 #include "services/blocks/contractor.hpp"
@@ -22,7 +24,9 @@ namespace fb {
 
 class MobileRobotBlock : public DeviceBlock {
  public:
-  MobileRobotBlock(std::string name, std::string resource_id, Numbers home, double speed);
+  // `resend_give_after`: how long a give may go unanswered before it is sent again.
+  MobileRobotBlock(std::string name, std::string resource_id, Numbers home, double speed,
+                   std::chrono::milliseconds resend_give_after = std::chrono::seconds(2));
 
   // Driving to each source and on to the destination, s; a refusal when a place is unknown.
   Contractor::Estimate estimate(const std::vector<std::string>& sources, const std::string& destination) const;
@@ -39,6 +43,10 @@ class MobileRobotBlock : public DeviceBlock {
   Numbers work_ends_at_;  // where the last batch taken on ends
   Data fetch_;          // the command being executed
   std::string give_id_;
+  Data give_;           // the give command for it, sent again while the buffer says nothing
+  bool give_heard_ = false;
+  std::chrono::steady_clock::time_point give_sent_at_;
+  std::chrono::milliseconds resend_give_after_;
   double distance_ = 0, moving_ = 0;  // so far in this fetch
 };
 

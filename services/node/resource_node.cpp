@@ -93,6 +93,7 @@ struct ResourceNode::Impl {
   std::unique_ptr<state::CellStore> store;
   std::string recovered;  // what the device did with what its predecessor process held
   std::chrono::steady_clock::time_point last_check;
+  std::chrono::steady_clock::time_point last_tick;
   dds::SimClock clock;
   std::unique_ptr<dds::Writer<cell::Capability, cell::CapabilityPubSubType>> capabilities;
   // Answers to commands the resource's queue had no room for, written on the listener thread.
@@ -202,6 +203,11 @@ struct ResourceNode::Impl {
       e.state(cell::ABORTED);
       e.reason(reason.substr(0, cell::Text::max_size - 1));
       e.sim_time(clock.now());
+      // The same command sent again (its sender heard nothing) gets this answer again, not a
+      // second execution.
+      device.ended(c.command_id, {{"command_id", c.command_id}, {"resource_id", config.id}, {"order_id", c.order},
+                                  {"operation", c.operation}, {"part", c.part}, {"state", std::string("aborted")},
+                                  {"reason", reason}, {"sim_time", e.sim_time()}});
       overflow_answers->write(e);
     }
   }
@@ -315,6 +321,11 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     if (n.store && now - n.last_check > std::chrono::seconds(1)) {
       n.last_check = now;
       n.resource.post("order_watch", "CHECK");
+    }
+    // A device that waits on others (a robot on a buffer's answer) looks again now and then.
+    if (n.device.has_input("TICK") && now - n.last_tick > std::chrono::milliseconds(500)) {
+      n.last_tick = now;
+      n.resource.post(n.device.name(), "TICK");
     }
   });
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(

@@ -38,6 +38,9 @@ TEST_CASE("chaos: kills of any process lose no part, leave no hold and no proces
   }
   CHECK(r.holds_left == 0);
   CHECK(r.down_ok);
+  std::string left;
+  for (const auto& p : r.processes_left) left += p + "\n";
+  INFO("processes left after cellctl down:\n" << left);
   CHECK(r.processes_left.empty());
   CHECK(r.integrity == "ok");
 }

@@ -104,6 +104,39 @@ TEST_CASE("mobile robot: a buffer that refuses fails the fetch with its reason",
   CHECK(f.block().state() == "READY");
 }
 
+TEST_CASE("mobile robot: a give that no event answers goes again, the same command, until one is heard",
+          "[fb][mobile-robot]") {
+  // Sent again at the first look after 0 ms: no test waits on the clock.
+  fb::BlockTestFixture<fb::MobileRobotBlock> f("robot", "robot-1", fb::Numbers{1, 0, 1}, 0.5, std::chrono::milliseconds(0));
+  f.send("SIM_REPLY", reply_to(f.send("INIT")[0]));
+  f.send("PLACE", {{"resource_id", std::string("buffer-1")}, {"dock", fb::Numbers{2, 0, 0}}});
+  f.send("PLACE", {{"resource_id", std::string("station-1")}, {"dock", fb::Numbers{0.6, 0, 0}}});
+  CHECK(f.send("TICK").empty());  // nothing to look after yet
+  fb::Data fetch{{"command_id", std::string("f1")}, {"resource_id", std::string("robot-1")},
+                 {"operation", std::string("fetch")}, {"order_id", std::string("o1")},
+                 {"part", std::string("o1/peg")}, {"part_type", std::string("Peg")},
+                 {"source", std::string("buffer-1")}, {"destination", std::string("station-1")},
+                 {"source_award", std::string("o1/give/Peg")}};
+  f.send("COMMAND", fetch);
+  const auto to_buffer = f.send("START", {{"command_id", std::string("f1")}});
+  const auto give = f.send("SIM_REPLY", reply_to(to_buffer[0], {{"start_time", 1.0}, {"end_time", 3.0}, {"distance", 1.0}}));
+  REQUIRE(names<fb::MobileRobotBlock>(give) == Names{"GIVE"});
+  const auto again = f.send("TICK");
+  REQUIRE(names<fb::MobileRobotBlock>(again) == Names{"GIVE"});
+  CHECK(again[0].data == give[0].data);  // the same command id: the buffer carries it out once
+  // An answer to another robot's give is not an answer to this one.
+  f.send("GIVE_EVENT", {{"command_id", std::string("f9/give")}, {"state", std::string("accepted")}, {"reason", std::string()}});
+  CHECK(names<fb::MobileRobotBlock>(f.send("TICK")) == Names{"GIVE"});
+  const std::string& id = fb::get<std::string>(give[0].data, "command_id");
+  f.send("GIVE_EVENT", {{"command_id", id}, {"state", std::string("accepted")}, {"reason", std::string()}});
+  CHECK(f.send("TICK").empty());  // heard: its final event will come
+  CHECK(f.block().state() == "WAIT_GIVE");
+  const auto to_station =
+      f.send("GIVE_EVENT", {{"command_id", id}, {"state", std::string("succeeded")}, {"reason", std::string()}});
+  REQUIRE(names<fb::MobileRobotBlock>(to_station) == Names{"SIM"});
+  CHECK(f.send("TICK").empty());
+}
+
 TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the first collision", "[sim][world]") {
   sim::SimWorld world;
   world.spawn({"table", "", Eigen::Vector3d(1, 0.025, 1), sim::Pose(Eigen::Translation3d(0, -0.025, 0)), true, "", false});

@@ -67,13 +67,16 @@ struct Outcome {
 
 // The stand-in cell's answers. `collide(move, parts placed so far)`: a cell-sim move that collides;
 // `refuse(command)`: a reason to abort a command with (empty: it succeeds; kNoAnswer: it is
-// never answered); `ahead`: the station's queue before this order.
+// never answered); `ahead`: the station's queue before this order; `turns_ours`: the station
+// that is reserved for the order once it said it waits (another than station-1: the booking
+// an earlier twin of the order left there).
 const std::string kNoAnswer = "(no answer)";
 struct Cell {
   std::function<bool(const Data&, long)> collide = [](const Data&, long) { return false; };
   std::function<std::string(const Data&)> refuse = [](const Data&) { return std::string(); };
   std::function<std::string(const Data&)> refuse_call = [](const Data&) { return std::string(); };  // a CFP
   long ahead = 0;
+  std::string turns_ours = "station-1";
 };
 
 Outcome run(Twin& t, const Cell& cell) {
@@ -104,7 +107,7 @@ Outcome run(Twin& t, const Cell& cell) {
       // The station's queue moves on once the order has said it waits.
       if (cell.ahead == 0 || !queued_reported || out.finished) break;
       queued_reported = false;
-      pending = capability("station-1", "station", "host", "o1");
+      pending = capability(cell.turns_ours, "station", "host", "o1");
       continue;
     }
     const fb::Event e = pending.front();
@@ -113,16 +116,23 @@ Outcome run(Twin& t, const Cell& cell) {
     if (e.name == "CFP") {
       const std::string& op = get<std::string>(e.data, "operation");
       out.order.push_back("CFP " + op);
-      const std::string resource = op == "host" ? "station-1" : op == "translate" ? "arm-1"
+      const std::string& only = get<std::string>(e.data, "station");
+      const std::string resource = op == "host" ? (only.empty() ? "station-1" : only) : op == "translate" ? "arm-1"
                                  : op == "fetch" ? "mobile-robot-1" : "buffer-1";
       const std::string no = cell.refuse_call(e.data);
       more = t.send("negotiator", "PROPOSAL", {{"call_id", e.data.at("call_id")}, {"resource_id", resource},
                                                {"available", no.empty()}, {"reason", no},
                                                {"earliest_start", 0.0}, {"duration", 1.0}});
+      if (op == "host" && resource != "station-1") {  // a call for one station: the other says no
+        const auto refusal = t.send("negotiator", "PROPOSAL", {{"call_id", e.data.at("call_id")}, {"resource_id", std::string("station-1")},
+                                                               {"available", false}, {"reason", std::string("not station-1")},
+                                                               {"earliest_start", 0.0}, {"duration", 0.0}});
+        more.insert(more.end(), refusal.begin(), refusal.end());
+      }
     } else if (e.name == "QUOTE") {
       out.quote = e.data;
     } else if (e.name == "AWARD") {
-      out.order.push_back("AWARD");
+      out.order.push_back("AWARD " + get<std::string>(e.data, "resource_id"));
       const bool host = get<std::string>(e.data, "resource_id") == "station-1";
       more = t.send("negotiator", "AWARD_REPLY", {{"call_id", e.data.at("call_id")},
                                                   {"resource_id", e.data.at("resource_id")}, {"confirmed", true},
@@ -146,6 +156,8 @@ Outcome run(Twin& t, const Cell& cell) {
                                                       {"order_id", e.data.at("order_id")},
                                                       {"state", std::string(reason.empty() ? "succeeded" : "aborted")},
                                                       {"reason", reason}});
+    } else if (e.name == "RELEASE") {
+      out.order.push_back("RELEASE " + get<std::string>(e.data, "resource_id"));
     } else if (e.name == "CANCEL") {
       out.canceled.push_back(get<std::string>(e.data, "command_id"));
     } else if (e.name == "STATUS") {
@@ -214,6 +226,22 @@ TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on whe
   INFO(out.error);
   CHECK(out.complete);
   CHECK(std::find(out.statuses.begin(), out.statuses.end(), "waiting for station-1: 3 orders ahead") != out.statuses.end());
+}
+
+TEST_CASE("orchestrator: a waiting order takes the station that turns out reserved for it, and leaves the queue",
+          "[twin][orchestration]") {
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
+  Twin t(lego.product, lego.plan);
+  Cell cell;
+  cell.ahead = 2;
+  cell.turns_ours = "station-2";
+  const Outcome out = run(t, cell);
+  INFO(out.error);
+  CHECK(out.complete);
+  const auto at = [&](const std::string& what) { return std::find(out.order.begin(), out.order.end(), what) - out.order.begin(); };
+  CHECK(at("RELEASE station-1") < at("AWARD station-2"));
+  CHECK(at("AWARD station-2") < at("COMMAND grip"));
+  CHECK(at("COMMAND grip") < static_cast<long>(out.order.size()));
 }
 
 TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequence planning", "[twin][orchestration]") {
@@ -286,7 +314,7 @@ TEST_CASE("orchestrator: an order for a quote assembles virtually, asks for bids
   INFO(out.error);
   CHECK(out.complete);
   CHECK(std::count(out.order.begin(), out.order.end(), "SIM set_static") == static_cast<long>(cranfield.plan.steps.size()));
-  CHECK(std::find(out.order.begin(), out.order.end(), "AWARD") == out.order.end());
+  CHECK(std::none_of(out.order.begin(), out.order.end(), [](const std::string& o) { return o.rfind("AWARD", 0) == 0; }));
   CHECK(std::none_of(out.order.begin(), out.order.end(), [](const std::string& s) { return s.rfind("COMMAND", 0) == 0; }));
   CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") != out.order.end());
   CHECK(std::find(out.order.begin(), out.order.end(), "CFP fetch") != out.order.end());
@@ -316,5 +344,5 @@ TEST_CASE("orchestrator: a quote nobody can bid on ends with every refusal's rea
   CHECK(out.finished);
   CHECK_FALSE(out.quote);
   CHECK(out.error.find("buffer-1 has 0 Brick2x2 free") != std::string::npos);
-  CHECK(std::find(out.order.begin(), out.order.end(), "AWARD") == out.order.end());
+  CHECK(std::none_of(out.order.begin(), out.order.end(), [](const std::string& o) { return o.rfind("AWARD", 0) == 0; }));
 }

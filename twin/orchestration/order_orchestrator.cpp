@@ -247,10 +247,14 @@ void OrderOrchestrator::book(std::string only) {
 
 // Orders booked at the same moment see the same bids and may crowd one station: an order
 // that waits moves to another station whose queue is shorter by two or more, or that is free.
+// A station reserved for this order already is free for it: an earlier twin of the order
+// queued there, and the station kept the booking through the restart.
 void OrderOrchestrator::consider_moving_to(const std::string& station) {
   if (!settings_.resume.station.empty()) return;
   const Place& p = places_.at(station);
-  const long load = (p.reserved_by.empty() ? 0 : 1) + static_cast<long>(p.waiting.size());
+  const long load = p.reserved_by == settings_.order_id
+                        ? 0
+                        : (p.reserved_by.empty() ? 0 : 1) + static_cast<long>(p.waiting.size());
   if (ahead_ < 1 || !(load == 0 || load + 1 < ahead_)) return;
   emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", station_}});
   awarded_.erase(station_);
