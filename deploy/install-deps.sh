@@ -12,6 +12,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
   chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
+  clang libclang-rt-14-dev  # the sanitizer builds and the libFuzzer targets (deploy/test.sh)
 )
 
 missing=()

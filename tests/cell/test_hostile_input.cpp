@@ -30,7 +30,7 @@ using namespace std::chrono_literals;
 
 // A sanitizer's allocator keeps freed memory (ASan's quarantine, TSan's shadow and history):
 // resident memory says nothing about the program's there.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#ifdef CELL_UNDER_SANITIZER
 constexpr bool kUnderSanitizer = true;
 #else
 constexpr bool kUnderSanitizer = false;
