@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs what is missing, then builds and runs the whole test suite twice: a Release
-# build (GCC), and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer (clang:
-# it compiles this tree faster than GCC, and the libFuzzer targets are built in it too, one
-# build less); then the block, DDS and process tests (labels blocks, dds, processes) once
-# more under ThreadSanitizer; then each libFuzzer target for 30 s (deploy/fuzz.sh; longer
-# runs, optimised, by hand). docs/performance.md has the time of each phase.
+# build (GCC), and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer; then
+# the block, DDS and process tests (labels blocks, dds, processes) once more under
+# ThreadSanitizer; then each libFuzzer target for 30 s (deploy/fuzz.sh; longer runs,
+# optimised, by hand). The sanitizer trees are built with clang: it compiles them faster
+# than GCC, and the libFuzzer targets are built in the ASan tree, one build less.
+# docs/performance.md has the time of each phase.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh
@@ -26,7 +27,8 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
   LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs"
 
-cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_TSAN=ON -DCELL_BUILD_BENCHMARKS=OFF
+cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_TSAN=ON -DCMAKE_CXX_COMPILER=clang++ \
+  -DCELL_BUILD_BENCHMARKS=OFF
 # Only what the labels below run (the unit tests of planning need no second thread).
 cmake --build build/tsan -j "$jobs" --target cellctl service_tests state_tests orchestration_tests dds_tests process_tests \
   two_host_tests

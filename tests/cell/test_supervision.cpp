@@ -68,6 +68,9 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
 
   // cellctl up dies hard: its processes end with it (they asked for SIGTERM when their parent goes).
   const auto children = test::children_of(up->pid());
+  std::string names;
+  for (const auto& [name, pid] : children) names += name + " (pid " + std::to_string(pid) + ")\n";
+  INFO(names);
   REQUIRE(children.size() == 6);  // cell-sim, the station, the robot, two buffers, a standby twin
   up->kill_hard();
   const auto deadline = std::chrono::steady_clock::now() + 20s;

@@ -85,7 +85,11 @@ inline std::vector<std::pair<std::string, pid_t>> children_of(pid_t parent) {
     rest >> state >> ppid;
     if (ppid != parent) continue;
     const auto open = line.find('(');
-    out.push_back({line.substr(open + 1, close - open - 1), static_cast<pid_t>(std::stol(name))});
+    const std::string command = line.substr(open + 1, close - open - 1);
+    // clang's sanitizer runtimes start it to name the frames of a report or a suppression:
+    // not one of the cell's processes.
+    if (command == "llvm-symbolizer") continue;
+    out.push_back({command, static_cast<pid_t>(std::stol(name))});
   }
   return out;
 }
