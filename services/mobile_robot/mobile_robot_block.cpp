@@ -73,14 +73,14 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
     give_heard_ = false;
     give_sent_at_ = std::chrono::steady_clock::now();
     give_ = {{"command_id", give_id_},
-                  {"resource_id", fetch_.at("source")},
-                  {"order_id", fetch_.at("order_id")},
-                  {"award", get_or<std::string>(fetch_, "source_award", "")},
-                  {"operation", std::string("give")},
-                  {"part", fetch_.at("part")},
-                  {"part_type", fetch_.at("part_type")},
-                  {"destination", resource_id()},  // who takes the part: the buffer's record says so
-                  {"sim_time", get<double>(reply, "end_time")}};
+             {"resource_id", fetch_.at("source")},
+             {"order_id", fetch_.at("order_id")},
+             {"award", get_or<std::string>(fetch_, "source_award", "")},
+             {"operation", std::string("give")},
+             {"part", fetch_.at("part")},
+             {"part_type", fetch_.at("part_type")},
+             {"destination", resource_id()},  // who takes the part: the buffer's record says so
+             {"sim_time", get<double>(reply, "end_time")}};
     emit("GIVE", give_);
   }, arrived);
   transition("TO_SOURCE", "SIM_REPLY", "READY", fail, answered);
