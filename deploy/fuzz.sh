@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target for a bounded time on its corpus in tests/fuzz/corpus (seeded
 # with the example products), printing libFuzzer's totals. A crash, a leak or a time-out
-# fails the script; the input that did it is kept in OUT/artifacts.
+# fails the script; the input that did it is kept in build/fuzz/artifacts.
 #   bash deploy/fuzz.sh [SECONDS_PER_TARGET [BUILD_DIR]]     (default 60, build/fuzz)
 # Without BUILD_DIR it builds the targets in build/fuzz (clang, optimised, ASan + UBSan). CI
 # gives its clang sanitizer tree, which built them beside the tests (deploy/test.sh): one
