@@ -93,6 +93,25 @@ double grown_by(const btCollisionShape* shape) {
   return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
 }
 
+// The volume a convex child (box, hull or triangle) at `offset` sweeps while its body moves by
+// `shift` (in the body's frame) without turning: the hull of its corners and the same corners
+// shifted, which is exactly that volume. A box's corners hold its margin, so its hull keeps
+// the box's surface where grown_by adds the margin back.
+std::unique_ptr<btConvexHullShape> swept_hull(const btCollisionShape& child, const btTransform& offset,
+                                              const btVector3& shift) {
+  const auto& polyhedron = static_cast<const btPolyhedralConvexShape&>(child);
+  auto hull = std::make_unique<btConvexHullShape>();
+  for (int v = 0; v < polyhedron.getNumVertices(); ++v) {
+    btVector3 p;
+    polyhedron.getVertex(v, p);
+    hull->addPoint(offset * p, false);
+    hull->addPoint(offset * p + shift, false);
+  }
+  hull->recalcLocalAabb();
+  hull->setMargin(child.getMargin());
+  return hull;
+}
+
 // The distance between two convex shapes' surfaces (Bullet units, 0 where they overlap; huge
 // where GJK gives no answer) and the normal from b towards a, by GJK (EPA where they overlap).
 std::pair<double, btVector3> convex_distance(const btConvexShape* a, const btTransform& ta, const btConvexShape* b,
@@ -153,6 +172,13 @@ void static_pieces(const btCollisionShape* shape, const btTransform& world, cons
   }
   visit(static_cast<const btConvexShape*>(shape), world);
 }
+
+// A convex piece of a moving body, where it stands (world), and the member it belongs to.
+struct MovingPiece {
+  const btConvexShape* shape;
+  btTransform at;
+  const std::string* member;
+};
 
 struct Overlapping : btBroadphaseAabbCallback {
   std::vector<const btCollisionObject*> objects;
@@ -377,6 +403,42 @@ struct CollisionWorld::Impl {
     bodies[next_id] = std::move(body);
     return next_id++;
   }
+
+  // The nearest pair of a moving piece and a piece of the `near` bodies within `threshold`
+  // (Bullet units) that `counts` keeps. Piece by piece, GJK on each pair within reach:
+  // Bullet's own closest-point query builds a collision algorithm per call, which cost more
+  // than the distances.
+  std::optional<Clearance> nearest_of(const std::vector<MovingPiece>& pieces,
+                                      const std::vector<const btCollisionObject*>& near, btScalar threshold,
+                                      const ClearanceFilter& counts) const {
+    std::optional<Clearance> best;
+    for (const MovingPiece& piece : pieces) {
+      btVector3 box_lo, box_hi;
+      piece.shape->getAabb(piece.at, box_lo, box_hi);
+      for (const btCollisionObject* other : near) {
+        // Only what is nearer than the nearest so far: the box shrinks as the search goes.
+        const btScalar within = best ? static_cast<btScalar>(best->distance * kUnitsPerMetre) : threshold;
+        const btVector3 lo = box_lo - btVector3(within, within, within), hi = box_hi + btVector3(within, within, within);
+        const Body& b = bodies.at(other->getUserIndex());
+        const btCollisionObject* exact = b.exact ? b.exact.get() : b.object.get();
+        static_pieces(exact->getCollisionShape(), exact->getWorldTransform(), lo, hi,
+                      [&](const btConvexShape* against, const btTransform& against_at) {
+                        const auto [distance, normal] = convex_distance(piece.shape, piece.at, against, against_at);
+                        const double metres = distance / kUnitsPerMetre;
+                        if (distance > threshold || (best && metres >= best->distance)) return;
+                        Clearance c;
+                        c.body = other->getUserIndex();
+                        c.distance = metres;
+                        c.normal = Eigen::Vector3d(normal.x(), normal.y(), normal.z());
+                        c.member = *piece.member;
+                        if (counts && !counts(c)) return;
+                        best = c;
+                      });
+      }
+    }
+    if (best) best->body_name = bodies.at(best->body).name;
+    return best;
+  }
 };
 
 
@@ -437,37 +499,59 @@ std::optional<Clearance> CollisionWorld::nearest(const MovingBody& body, const P
   shape.compound.getAabb(at, min, max);
   Overlapping near;
   impl_->broadphase.aabbTest(min - pad, max + pad, near);
-  std::optional<Clearance> best;
-  // Piece by piece, GJK on each pair within reach: Bullet's own closest-point query builds a
-  // collision algorithm per call, which cost more than the distances.
+  std::vector<MovingPiece> pieces;
   for (int i = 0; i < shape.compound.getNumChildShapes(); ++i) {
-    const auto* piece = static_cast<const btConvexShape*>(shape.compound.getChildShape(i));
-    const btTransform piece_at = at * shape.compound.getChildTransform(i);
-    btVector3 box_lo, box_hi;
-    piece->getAabb(piece_at, box_lo, box_hi);
-    for (const btCollisionObject* other : near.objects) {
-      // Only what is nearer than the nearest so far: the box shrinks as the search goes.
-      const btScalar within = best ? static_cast<btScalar>(best->distance * kUnitsPerMetre) : threshold;
-      const btVector3 lo = box_lo - btVector3(within, within, within), hi = box_hi + btVector3(within, within, within);
-      const auto& b = impl_->bodies.at(other->getUserIndex());
-      const btCollisionObject* exact = b.exact ? b.exact.get() : b.object.get();
-      static_pieces(exact->getCollisionShape(), exact->getWorldTransform(), lo, hi,
-                    [&](const btConvexShape* against, const btTransform& against_at) {
-                      const auto [distance, normal] = convex_distance(piece, piece_at, against, against_at);
-                      const double metres = distance / kUnitsPerMetre;
-                      if (distance > threshold || (best && metres >= best->distance)) return;
-                      Clearance c;
-                      c.body = other->getUserIndex();
-                      c.distance = metres;
-                      c.normal = Eigen::Vector3d(normal.x(), normal.y(), normal.z());
-                      c.member = shape.member_of_child[static_cast<std::size_t>(i)];
-                      if (counts && !counts(c)) return;
-                      best = c;
-                    });
-    }
+    pieces.push_back({static_cast<const btConvexShape*>(shape.compound.getChildShape(i)),
+                      at * shape.compound.getChildTransform(i), &shape.member_of_child[static_cast<std::size_t>(i)]});
   }
-  if (best) best->body_name = impl_->bodies.at(best->body).name;
-  return best;
+  return impl_->nearest_of(pieces, near.objects, threshold, counts);
+}
+
+// Without turning, one distance per pair of pieces covers the whole move: the distance to a
+// child's swept volume (swept_hull) is the least it comes to along the move. Sampling took one
+// per pair and millimetre. A pair is judged where it comes nearest: one that closes head-on
+// at the move's end is a seat, which `counts` leaves out.
+std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& body, const Pose& from,
+                                                             const Eigen::Vector3d& shift, double reach,
+                                                             const ClearanceFilter& counts) const {
+  ++checks_;
+  MovingBody::Impl::Shape& shape = body.impl_->has_exact ? body.impl_->exact_shape() : body.impl_->coarse;
+  const btTransform at = to_bullet(from);
+  btTransform end = at;
+  end.setOrigin(at.getOrigin() + to_bullet(shift));
+  const btVector3 local_shift = to_bullet(Eigen::Vector3d(from.linear().transpose() * shift));
+  const btScalar threshold = static_cast<btScalar>(reach * kUnitsPerMetre);
+  const btVector3 pad(threshold, threshold, threshold);
+  const auto swept_box = [&](const btCollisionShape& s, const btTransform& offset, btVector3& lo, btVector3& hi) {
+    btVector3 lo_end, hi_end;
+    s.getAabb(at * offset, lo, hi);
+    s.getAabb(end * offset, lo_end, hi_end);
+    lo.setMin(lo_end);
+    hi.setMax(hi_end);
+  };
+  btVector3 min, max;
+  swept_box(shape.compound, btTransform::getIdentity(), min, max);
+  Overlapping near;
+  impl_->broadphase.aabbTest(min - pad, max + pad, near);
+  if (near.objects.empty()) return std::nullopt;
+  // Swept hulls only for the children that come within reach of a near body's box: a concave
+  // part's exact shape has a child per triangle.
+  std::vector<std::unique_ptr<btConvexHullShape>> hulls;
+  std::vector<MovingPiece> pieces;
+  for (int i = 0; i < shape.compound.getNumChildShapes(); ++i) {
+    const btCollisionShape& child = *shape.compound.getChildShape(i);
+    const btTransform& offset = shape.compound.getChildTransform(i);
+    btVector3 lo, hi;
+    swept_box(child, offset, lo, hi);
+    const bool within_reach = std::any_of(near.objects.begin(), near.objects.end(), [&](const btCollisionObject* o) {
+      const btBroadphaseProxy* proxy = o->getBroadphaseHandle();
+      return TestAabbAgainstAabb2(lo - pad, hi + pad, proxy->m_aabbMin, proxy->m_aabbMax);
+    });
+    if (!within_reach) continue;
+    hulls.push_back(swept_hull(child, offset, local_shift));
+    pieces.push_back({hulls.back().get(), at, &shape.member_of_child[static_cast<std::size_t>(i)]});
+  }
+  return impl_->nearest_of(pieces, near.objects, threshold, counts);
 }
 
 namespace {
@@ -482,30 +566,16 @@ struct AnyOverlap : btBroadphaseAabbCallback {
 
 }  // namespace
 
-// The volume that the coarse body sweeps while it moves by `shift` (in its own frame) without
-// turning: each convex child's points and the same points shifted, whose hull is exactly the
-// child's swept volume. It holds the body at every pose of the move, so it reaches at least
-// as deep as any of them: when it is clear, so is the whole move.
+// The coarse body's swept volume (swept_hull, child by child) holds it at every pose of the
+// move, so it reaches at least as deep as any of them: when it is clear, so is the whole move.
 bool CollisionWorld::clear_translation(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift) const {
   const btCompoundShape& coarse = body.impl_->coarse.compound;
   const btVector3 d = to_bullet(shift);
   btCompoundShape swept(true, coarse.getNumChildShapes());
   std::vector<std::unique_ptr<btConvexHullShape>> hulls;
   for (int i = 0; i < coarse.getNumChildShapes(); ++i) {
-    // Boxes and hulls, whose vertices leave the margin out, as the hull's own margin does.
-    const auto& child = static_cast<const btPolyhedralConvexShape&>(*coarse.getChildShape(i));
-    const btTransform& offset = coarse.getChildTransform(i);
-    auto hull = std::make_unique<btConvexHullShape>();
-    for (int v = 0; v < child.getNumVertices(); ++v) {
-      btVector3 p;
-      child.getVertex(v, p);
-      hull->addPoint(offset * p, false);
-      hull->addPoint(offset * p + d, false);
-    }
-    hull->recalcLocalAabb();
-    hull->setMargin(child.getMargin());
-    swept.addChildShape(btTransform::getIdentity(), hull.get());
-    hulls.push_back(std::move(hull));
+    hulls.push_back(swept_hull(*coarse.getChildShape(i), coarse.getChildTransform(i), d));
+    swept.addChildShape(btTransform::getIdentity(), hulls.back().get());
   }
   btCollisionObject object;
   object.setCollisionShape(&swept);
@@ -567,38 +637,44 @@ std::optional<Clearance> CollisionWorld::nearest_along(const MovingBody& body, c
                                                        double reach, const ClearanceFilter& counts) const {
   const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
   const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
+  const bool translating = angle < 1e-9;
   const btCollisionShape& shape = body.impl_->coarse.compound;
   const double pad = (angle * body.radius() + reach) * kUnitsPerMetre;
   std::optional<Clearance> best;
-  const auto sample = [&](double s) {
-    // Only what is nearer than the nearest so far matters: Bullet then leaves more pairs out.
-    auto c = nearest(body, interpolate(from, to, s), best ? best->distance : reach, counts);
-    if (c && (!best || c->distance < best->distance)) {
-      c->fraction = s;
-      best = c;
-    }
+  const auto keep = [&](std::optional<Clearance> c) {
+    if (c && (!best || c->distance < best->distance)) best = c;
   };
-  // As sweep: a stretch whose box, grown by the reach, overlaps no body is skipped; the rest
-  // is halved down to linear_step and sampled at its ends.
+  // Only what is nearer than the nearest so far matters: Bullet then leaves more pairs out.
+  const auto within = [&] { return best ? best->distance : reach; };
+  // As sweep: a stretch whose box, grown by the reach, overlaps no body is skipped. The rest
+  // is halved: without turning, down to stretches of the reach, each measured whole
+  // (nearest_translating; shorter stretches keep its boxes small); else down to linear_step,
+  // sampled at its ends.
   auto visit = [&](auto&& self, double s0, double s1) -> void {
+    const Pose a = interpolate(from, to, s0), b = interpolate(from, to, s1);
     btVector3 min_a, max_a, min_b, max_b;
-    shape.getAabb(to_bullet(interpolate(from, to, s0)), min_a, max_a);
-    shape.getAabb(to_bullet(interpolate(from, to, s1)), min_b, max_b);
+    shape.getAabb(to_bullet(a), min_a, max_a);
+    shape.getAabb(to_bullet(b), min_b, max_b);
     min_a.setMin(min_b);
     max_a.setMax(max_b);
     const btVector3 padding(pad, pad, pad);
     AnyOverlap overlap;
     impl_->broadphase.aabbTest(min_a - padding, max_a + padding, overlap);
     if (!overlap.found) return;
-    if ((s1 - s0) * travel <= options_.linear_step) {
-      sample(s1);
+    const double length = (s1 - s0) * travel;
+    if (translating && length <= std::max(4 * reach, options_.linear_step)) {
+      keep(nearest_translating(body, a, b.translation() - a.translation(), within(), counts));
+      return;
+    }
+    if (!translating && length <= options_.linear_step) {
+      keep(nearest(body, b, within(), counts));
       return;
     }
     const double mid = (s0 + s1) / 2;
     self(self, s0, mid);
     self(self, mid, s1);
   };
-  sample(0.0);
+  if (!translating) keep(nearest(body, from, reach, counts));
   visit(visit, 0.0, 1.0);
   return best;
 }

@@ -44,7 +44,6 @@ struct Clearance {
   std::string member;  // of the moving body
   double distance = 0;  // m; 0 where they touch or overlap
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, from the static body towards the moving one
-  double fraction = 0;  // where along a move, 0..1
 };
 // Which pairs count: false leaves a pair out (a contact that is meant to be).
 using ClearanceFilter = std::function<bool(const Clearance&)>;
@@ -104,8 +103,9 @@ class CollisionWorld {
   // `counts` (when given) keeps; nothing when none is that near.
   std::optional<Clearance> nearest(const MovingBody& body, const Pose& pose, double reach,
                                    const ClearanceFilter& counts = {}) const;
-  // The same along a move, sampled so that no point moves more than linear_step between
-  // samples (stretches farther than `reach` from every body are skipped whole).
+  // The same along a move: exact for a move without turning (each piece's swept volume);
+  // with turning, sampled so that no point moves more than linear_step between samples.
+  // Stretches farther than `reach` from every body are skipped whole.
   std::optional<Clearance> nearest_along(const MovingBody& body, const Pose& from, const Pose& to, double reach,
                                          const ClearanceFilter& counts = {}) const;
   // Penetration tests made so far (for benchmarks).
@@ -113,6 +113,8 @@ class CollisionWorld {
 
  private:
   bool clear_translation(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift) const;
+  std::optional<Clearance> nearest_translating(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift,
+                                               double reach, const ClearanceFilter& counts) const;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
