@@ -20,16 +20,17 @@ BufferBlock::BufferBlock(std::string name, std::string resource_id, std::map<std
     std::string type = get_or<std::string>(d, "part_type", "");
     if (type.empty()) type = get<std::string>(d, "part");
     const std::string order = get_or<std::string>(d, "order_id", "");
+    const std::string part = get_or<std::string>(d, "part", ""), destination = get_or<std::string>(d, "destination", "");
+    // A give that the process before this one did, and whose answer was lost with it, is
+    // answered again, not done twice.
+    if (store() && store()->given(this->resource_id(), order, part, destination)) return emit("DONE");
     int& kept = kept_[order][type];
     if (kept == 0 && free(type) == 0) {
       return emit("FAIL", {{"reason", "buffer " + this->resource_id() + " has no " + type +
                                            (order.empty() ? "" : " free for order " + order)}});
     }
     // The durable stock first: a part counted out in memory only would come back with a restart.
-    if (store()) {
-      store()->give(this->resource_id(), type, order, get_or<std::string>(d, "part", ""),
-                    get_or<std::string>(d, "destination", ""));
-    }
+    if (store()) store()->give(this->resource_id(), type, order, part, destination);
     if (kept > 0) --kept;
     --stock_[type];
     emit("DONE");
@@ -61,6 +62,12 @@ void BufferBlock::check(const Data& command, SampleCheck& c) const {
 
 std::string BufferBlock::recover() {
   const std::map<std::string, int> before = stock_;
+  // Counted out, never answered: the give is answered ABORTED (ResourceNode), so its part is
+  // back in the stock before the stock is read.
+  std::string undone;
+  for (const auto& p : store()->undo_unanswered_gives(resource_id())) {
+    undone += (undone.empty() ? "" : ", ") + p.part + " (" + p.part_type + ")";
+  }
   stock_ = store()->open_buffer(resource_id(), stock_);
   // What it kept for orders that ended while it was down goes back to the free stock.
   kept_ = store()->kept(resource_id());
@@ -69,6 +76,7 @@ std::string BufferBlock::recover() {
   }
   std::string changed = stock_ == before ? "" : "stock as stored, not as the deployment file gives it";
   if (!kept_.empty()) changed += std::string(changed.empty() ? "" : "; ") + std::to_string(kept_.size()) + " orders' parts kept";
+  if (!undone.empty()) changed += std::string(changed.empty() ? "" : "; ") + undone + " back in stock: given, never answered";
   return changed;
 }
 

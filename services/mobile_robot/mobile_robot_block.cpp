@@ -70,7 +70,6 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   transition("TO_SOURCE", "SIM_REPLY", "WAIT_GIVE", [this, account](const Data& reply) {
     account(reply);
     give_id_ = get<std::string>(fetch_, "command_id") + "/give";
-    give_heard_ = false;
     give_sent_at_ = std::chrono::steady_clock::now();
     give_ = {{"command_id", give_id_},
              {"resource_id", fetch_.at("source")},
@@ -90,15 +89,15 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   transition("WAIT_GIVE", "GIVE_EVENT", "READY", [this](const Data& d) {
     emit("FAIL", {{"reason", get<std::string>(d, "reason")}, {"distance", distance_}, {"duration", moving_}});
   }, [give_answer](const Data& d) { return give_answer("aborted")(d) || give_answer("rejected")(d); });
-  transition("WAIT_GIVE", "GIVE_EVENT", "WAIT_GIVE", [this](const Data&) { give_heard_ = true; },
-             [this](const Data& d) { return get<std::string>(d, "command_id") == give_id_; });
-  // A give the buffer never heard (written while a buffer that restarted was not matched
-  // again yet: commands are not kept for readers that come later) goes again; the buffer
-  // carries out a command id once, and answers a repeat with its last event.
+  // A give with no final answer yet goes again: one the buffer never heard (written while a
+  // buffer that restarted was not matched again: commands are not kept for readers that come
+  // later), and one whose answer was lost with a buffer that ended after the give. The buffer
+  // carries out a command id once: it ignores a repeat while at it, answers one it finished
+  // with its last event, and its next process answers one it did (BufferBlock).
   transition("WAIT_GIVE", "TICK", "WAIT_GIVE", [this](const Data&) {
     give_sent_at_ = std::chrono::steady_clock::now();
     emit("GIVE", give_);
-  }, [this](const Data&) { return !give_heard_ && std::chrono::steady_clock::now() - give_sent_at_ >= resend_give_after_; });
+  }, [this](const Data&) { return std::chrono::steady_clock::now() - give_sent_at_ >= resend_give_after_; });
   transition("TO_DESTINATION", "SIM_REPLY", "READY", [this, account](const Data& reply) {
     if (store()) {
       store()->deliver(get_or<std::string>(fetch_, "order_id", ""), get<std::string>(fetch_, "part"),

@@ -10,7 +10,7 @@
 //     -> GIVE_EVENT succeeded -> SIM move to the destination's dock carrying the part -> DONE
 //   PLACE (resource_id, dock): where a resource hands parts over
 //   AWARDED (sources, station): a batch of fetches it was hired for; it will end there
-//   TICK (wall time, from its node): a give that no event answered in time is sent again
+//   TICK (wall time, from its node): a give with no final answer in time is sent again
 // estimate(): how long a batch would take from where its work taken on so far ends.
 
 #include <chrono>
@@ -24,7 +24,7 @@ namespace fb {
 
 class MobileRobotBlock : public DeviceBlock {
  public:
-  // `resend_give_after`: how long a give may go unanswered before it is sent again.
+  // `resend_give_after`: how long a give may go without its final answer before it is sent again.
   MobileRobotBlock(std::string name, std::string resource_id, Numbers home, double speed,
                    std::chrono::milliseconds resend_give_after = std::chrono::seconds(2));
 
@@ -43,8 +43,7 @@ class MobileRobotBlock : public DeviceBlock {
   Numbers work_ends_at_;  // where the last batch taken on ends
   Data fetch_;          // the command being executed
   std::string give_id_;
-  Data give_;           // the give command for it, sent again while the buffer says nothing
-  bool give_heard_ = false;
+  Data give_;           // the give command for it, sent again until its final answer
   std::chrono::steady_clock::time_point give_sent_at_;
   std::chrono::milliseconds resend_give_after_;
   double distance_ = 0, moving_ = 0;  // so far in this fetch

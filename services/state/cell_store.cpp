@@ -222,6 +222,35 @@ void CellStore::give(const std::string& buffer, const std::string& type, const s
   t.commit();
 }
 
+bool CellStore::given(const std::string& buffer, const std::string& order, const std::string& part,
+                      const std::string& carrier) const {
+  Statement row(db_, "SELECT 1 FROM parts WHERE order_id = ? AND part = ? AND buffer = ? AND holder = ? "
+                     "AND place = 'in_transit'");
+  row.bind(order, part, buffer, carrier);
+  return row.step();
+}
+
+std::vector<PartRecord> CellStore::undo_unanswered_gives(const std::string& buffer) {
+  Transaction t(*this);
+  Statement rows(db_, "SELECT p.order_id, p.part, p.part_type, p.holder FROM parts p JOIN commands c "
+                      "ON c.resource = p.buffer AND c.order_id = p.order_id AND c.part = p.part AND c.operation = 'give' "
+                      "WHERE p.buffer = ? AND p.place = 'in_transit' ORDER BY p.order_id, p.part");
+  rows.bind(buffer);
+  std::vector<PartRecord> undone;
+  while (rows.step()) undone.push_back({rows.text(0), rows.text(1), rows.text(2), buffer, rows.text(3), Place::in_transit, ""});
+  for (const auto& p : undone) {
+    Statement(db_, "UPDATE stock SET count = count + 1 WHERE buffer = ? AND part_type = ?").bind(buffer, p.part_type).step();
+    Statement(db_, "UPDATE kept SET count = count + 1 WHERE buffer = ? AND order_id = ? AND part_type = ?")
+        .bind(buffer, p.order, p.part_type)
+        .step();
+    Statement(db_, "UPDATE parts SET place = 'returned', holder = '' WHERE order_id = ? AND part = ?")
+        .bind(p.order, p.part)
+        .step();
+  }
+  t.commit();
+  return undone;
+}
+
 void CellStore::keep(const std::string& buffer, const std::string& order, const std::string& type, int count) {
   Transaction t(*this);
   Statement(db_, "INSERT INTO kept(buffer, order_id, part_type, count) VALUES(?, ?, ?, ?) "

@@ -95,6 +95,14 @@ class CellStore {
   // Throws StoreError when the buffer has none.
   void give(const std::string& buffer, const std::string& type, const std::string& order, const std::string& part,
             const std::string& carrier);
+  // Whether `buffer` gave the part to `carrier` and it is still on its way: a give repeated
+  // after a restart that had done it (its answer was lost with the process).
+  bool given(const std::string& buffer, const std::string& order, const std::string& part,
+             const std::string& carrier) const;
+  // The gives `buffer` counted out whose commands its last process never answered (it ended
+  // between the two): the process after it answers them ABORTED, so their parts go back to
+  // its stock, and to what it keeps for their orders. Returns those parts, as they were.
+  std::vector<PartRecord> undo_unanswered_gives(const std::string& buffer);
   // Parts a buffer keeps for an order that won its award (counted down as they are given,
   // dropped when the order ends): order -> type -> count.
   void keep(const std::string& buffer, const std::string& order, const std::string& type, int count);

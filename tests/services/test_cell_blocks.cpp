@@ -1,13 +1,18 @@
 // The cell's device blocks and cell-sim's world, driven with events and no DDS.
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <thread>
 
 #include <catch2/catch.hpp>
 
+#include "services/buffer/buffer_block.hpp"
 #include "services/mobile_robot/mobile_robot_block.hpp"
 #include "services/runtime/block_test_fixture.hpp"
+#include "services/state/cell_store.hpp"
 #include "services/station/arm_block.hpp"
 #include "sim/cell_sim/world_block.hpp"
 #include "sim/world/sim_world.hpp"
@@ -104,7 +109,7 @@ TEST_CASE("mobile robot: a buffer that refuses fails the fetch with its reason",
   CHECK(f.block().state() == "READY");
 }
 
-TEST_CASE("mobile robot: a give that no event answers goes again, the same command, until one is heard",
+TEST_CASE("mobile robot: a give goes again, the same command, until its final answer is heard",
           "[fb][mobile-robot]") {
   // Sent again at the first look after 0 ms: no test waits on the clock.
   fb::BlockTestFixture<fb::MobileRobotBlock> f("robot", "robot-1", fb::Numbers{1, 0, 1}, 0.5, std::chrono::milliseconds(0));
@@ -128,13 +133,56 @@ TEST_CASE("mobile robot: a give that no event answers goes again, the same comma
   f.send("GIVE_EVENT", {{"command_id", std::string("f9/give")}, {"state", std::string("accepted")}, {"reason", std::string()}});
   CHECK(names<fb::MobileRobotBlock>(f.send("TICK")) == Names{"GIVE"});
   const std::string& id = fb::get<std::string>(give[0].data, "command_id");
+  // Accepted is not the end: a buffer that ends now takes the answer with it.
   f.send("GIVE_EVENT", {{"command_id", id}, {"state", std::string("accepted")}, {"reason", std::string()}});
-  CHECK(f.send("TICK").empty());  // heard: its final event will come
+  CHECK(names<fb::MobileRobotBlock>(f.send("TICK")) == Names{"GIVE"});
   CHECK(f.block().state() == "WAIT_GIVE");
   const auto to_station =
       f.send("GIVE_EVENT", {{"command_id", id}, {"state", std::string("succeeded")}, {"reason", std::string()}});
   REQUIRE(names<fb::MobileRobotBlock>(to_station) == Names{"SIM"});
   CHECK(f.send("TICK").empty());
+}
+
+TEST_CASE("buffer: a give whose answer died with the process is undone, or answered again, never done twice",
+          "[fb][buffer][state]") {
+  const auto dir = std::filesystem::temp_directory_path() / ("agile-cell-blocks-" + std::to_string(::getpid())) / "give";
+  std::filesystem::remove_all(dir);
+  state::CellStore store(dir);
+  const std::map<std::string, int> seed{{"Peg", 2}};
+  const fb::Data give{{"command_id", std::string("o1/g1")}, {"resource_id", std::string("buffer-1")},
+                      {"operation", std::string("give")}, {"order_id", std::string("o1")},
+                      {"part", std::string("o1/peg")}, {"part_type", std::string("Peg")},
+                      {"destination", std::string("robot-1")}};
+  {
+    // The process before: it takes the give on (the node records that) and counts the part
+    // out, and is killed before it answers.
+    fb::BlockTestFixture<fb::BufferBlock> before("buffer", "buffer-1", seed);
+    CHECK(before.block().keep_state_in(store).empty());
+    REQUIRE(names<fb::BufferBlock>(before.send("COMMAND", give)) == Names{"ACCEPT"});
+    store.command_taken({"buffer-1", "o1/g1", "o1", "give", "o1/peg"});
+    REQUIRE(names<fb::BufferBlock>(before.send("START", {{"command_id", std::string("o1/g1")}})) ==
+            Names{"DONE", "CAPABILITY"});
+    CHECK(before.block().count("Peg") == 1);
+  }
+  fb::BlockTestFixture<fb::BufferBlock> after("buffer", "buffer-1", seed);
+  SECTION("killed before the answer: the part is back, and the give is the new process's to abort") {
+    const std::string recovered = after.block().keep_state_in(store);
+    CHECK_THAT(recovered, Catch::Contains("o1/peg (Peg) back in stock"));
+    CHECK(after.block().count("Peg") == 2);
+    CHECK(store.inventory().at("Peg").in_transit == 0);
+    CHECK(store.take_interrupted("buffer-1").size() == 1);
+  }
+  SECTION("killed after it ended the command, before the answer went out: a repeat is answered, not done") {
+    store.command_ended("buffer-1", "o1/g1");
+    CHECK_THAT(after.block().keep_state_in(store), !Catch::Contains("back in stock"));
+    CHECK(after.block().count("Peg") == 1);
+    REQUIRE(names<fb::BufferBlock>(after.send("COMMAND", give)) == Names{"ACCEPT"});
+    REQUIRE(names<fb::BufferBlock>(after.send("START", {{"command_id", std::string("o1/g1")}})) == Names{"DONE"});
+    CHECK(after.block().count("Peg") == 1);
+    CHECK(store.inventory().at("Peg").in_transit == 1);
+    CHECK(store.inventory().at("Peg").in_buffers == 1);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the first collision", "[sim][world]") {

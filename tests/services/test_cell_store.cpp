@@ -130,6 +130,38 @@ TEST_CASE("the commands a resource had taken on are answered once by the process
   CHECK(store.take_interrupted("arm-1").size() == 1);
 }
 
+TEST_CASE("a give counted out whose command was never answered goes back to the buffer", "[state]") {
+  state::CellStore store(fresh_dir("unanswered"));
+  store.open_buffer("buffer-1", {{"Peg", 3}});
+  store.keep("buffer-1", "o1", "Peg", 2);
+  // Answered: counted out, its command ended. Unanswered: the process died between the two.
+  store.command_taken({"buffer-1", "o1/g1", "o1", "give", "o1/peg-1"});
+  store.give("buffer-1", "Peg", "o1", "o1/peg-1", "robot-1");
+  store.command_ended("buffer-1", "o1/g1");
+  store.command_taken({"buffer-1", "o1/g2", "o1", "give", "o1/peg-2"});
+  store.give("buffer-1", "Peg", "o1", "o1/peg-2", "robot-2");
+  // A robot's fetch of the same part, still open, is not a give.
+  store.command_taken({"robot-1", "o1/f1", "o1", "fetch", "o1/peg-1"});
+  CHECK(store.given("buffer-1", "o1", "o1/peg-2", "robot-2"));
+  CHECK_FALSE(store.given("buffer-1", "o1", "o1/peg-2", "robot-1"));  // not to that robot
+
+  const auto undone = store.undo_unanswered_gives("buffer-1");
+  REQUIRE(undone.size() == 1);
+  CHECK(undone.front().part == "o1/peg-2");
+  CHECK(undone.front().holder == "robot-2");
+  CHECK(store.inventory().at("Peg").in_buffers == 2);
+  CHECK(store.inventory().at("Peg").in_transit == 1);  // o1/peg-1, answered, is on its way
+  CHECK(store.kept("buffer-1").at("o1").at("Peg") == 1);  // kept for the order again
+  CHECK_FALSE(store.given("buffer-1", "o1", "o1/peg-2", "robot-2"));
+  require_conserved(store);
+  CHECK(store.undo_unanswered_gives("buffer-1").empty());  // once
+  // The command itself is still the restarted buffer's to answer (ABORTED), and the part may
+  // be given again under its name.
+  CHECK(store.take_interrupted("buffer-1").size() == 1);
+  store.give("buffer-1", "Peg", "o1", "o1/peg-2", "robot-2");
+  require_conserved(store);
+}
+
 TEST_CASE("bookings, orders and the journal", "[state]") {
   state::CellStore store(fresh_dir("holds"));
   store.set_bookings("station-1", {{"o1", {"o1/host"}, 40, true}, {"o2", {"o2/host", "o2/host-2"}, 30, false}});
