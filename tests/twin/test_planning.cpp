@@ -249,6 +249,27 @@ TEST_CASE("insertion margins: the room each part and its gripper have on the way
     options.margin_threshold = 0;  // no step is flagged
     CHECK_FALSE(has_finding(twin::plan_assembly(loaded, *s, *path, options), "margin", ""));
   }
+  SECTION("a one-piece concave part past the triangle limit is not measured, and the findings say so") {
+    loaded = twin::load_product(test::data("planning/lipped-box/lipped-box.aml"), cache);
+    auto s = twin::make_sequence_planner("search");
+    auto path = twin::make_path_planner("linear");
+    twin::PlannerOptions options;
+    const twin::Plan measured = twin::plan_assembly(loaded, *s, *path, options);
+    REQUIRE(measured.complete);
+    const auto o = order(loaded, measured);
+    const auto& wall = measured.steps[at(o, "wall_left")];
+    CHECK(wall.margin_measured);
+    const std::size_t triangles = loaded.meshes[*loaded.product.find_part_by_name("wall_left")]->triangles.size();
+    REQUIRE(triangles > 4);
+    options.margin_max_triangles = triangles - 1;
+    const twin::Plan limited = twin::plan_assembly(loaded, *s, *path, options);
+    REQUIRE(limited.complete);
+    CHECK_FALSE(limited.steps[at(order(loaded, limited), "wall_left")].margin_measured);
+    CHECK(has_finding(limited, "margin", "(wall_left): margin not measured: one concave piece of " +
+                                            std::to_string(triangles) + " triangles"));
+    // The block is one convex piece: measured whatever its size.
+    CHECK(limited.steps[at(order(loaded, limited), "block")].margin_measured);
+  }
 }
 
 TEST_CASE("suggested precedences settle the open order: written into the product, it plans the same with fewer choices",

@@ -126,6 +126,7 @@ class Search {
 
   void measure(PlanStep& step) const {
     if (options_.margin_reach <= 0) return;  // margins not asked for
+    if (scene_.exact_triangles(step.part) > options_.margin_max_triangles) return;
     step.margin = scene_.margin(step.part, step.trajectory, options_.margin_reach);
     step.margin_measured = true;
   }
@@ -236,6 +237,14 @@ class Search {
     }
     for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
       const PlanStep& step = plan_.steps[i];
+      if (options_.margin_reach > 0 && !step.margin_measured) {
+        plan_.findings.push_back({"margin",
+                                  "step " + std::to_string(i + 1) + " (" + name(step.part) + "): margin not measured: " +
+                                      "one concave piece of " + std::to_string(scene_.exact_triangles(step.part)) +
+                                      " triangles, more than the " + std::to_string(options_.margin_max_triangles) +
+                                      " measured (a part authored as convex pieces is measured at any size)",
+                                  {name(step.part)}});
+      }
       if (!step.margin || step.margin->distance >= options_.margin_threshold) continue;
       const Margin& m = *step.margin;
       plan_.findings.push_back({"margin",

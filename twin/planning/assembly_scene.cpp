@@ -169,6 +169,11 @@ std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& tr
   return least;
 }
 
+std::size_t AssemblyScene::exact_triangles(PartIndex part) const {
+  const auto& mesh = product_.meshes[part];
+  return mesh && mesh->pieces.size() == 1 && !mesh->convex ? mesh->triangles.size() : 0;
+}
+
 Collision AssemblyScene::to_collision(const sim::Contact& contact, const std::string& phase) const {
   const auto it = names_.find(contact.body);
   return {it == names_.end() ? contact.body_name : it->second, contact.member, contact.depth, phase};

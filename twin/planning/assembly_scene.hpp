@@ -78,6 +78,9 @@ class AssemblyScene {
   // across the motion: where the part closes on a surface head-on, along the insertion
   // direction, it is coming to its seat, meant to close, and that contact is left out.
   std::optional<Margin> margin(PartIndex part, const Trajectory& trajectory, double reach) const;
+  // The triangles the part is measured by, one convex shape each, where it is one concave
+  // piece; 0 where its mesh is convex pieces.
+  std::size_t exact_triangles(PartIndex part) const;
 
   const sim::CollisionWorld& world() const { return world_; }
 
