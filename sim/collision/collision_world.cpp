@@ -178,7 +178,38 @@ struct MovingPiece {
   const btConvexShape* shape;
   btTransform at;
   const std::string* member;
+  // A piece that closes on its seat along `ahead` (world, unit): static pieces wholly beyond
+  // `ends_at` along it are not asked.
+  btVector3 ahead{0, 0, 0};
+  btScalar ends_at = BT_LARGE_FLOAT;
 };
+
+// Where the piece closes along an axis of the world (the usual insertion), the search box
+// ends where the piece does: the box query leaves out what lies beyond.
+void cut_at_end(const MovingPiece& piece, btVector3& lo, btVector3& hi) {
+  if (piece.ends_at >= BT_LARGE_FLOAT) return;
+  for (int k = 0; k < 3; ++k) {
+    if (piece.ahead[k] > 1 - 1e-9) hi[k] = std::min(hi[k], piece.ends_at);
+    if (piece.ahead[k] < -1 + 1e-9) lo[k] = std::max(lo[k], -piece.ends_at);
+  }
+}
+
+// How far along `axis` the static piece begins (its least extent, margin included).
+btScalar begins_at(const btConvexShape* piece, const btTransform& at, const btVector3& axis) {
+  if (piece->getShapeType() == TRIANGLE_SHAPE_PROXYTYPE) {
+    const auto* t = static_cast<const btTriangleShape*>(piece);
+    btScalar least = BT_LARGE_FLOAT;
+    for (const btVector3& v : t->m_vertices1) least = std::min(least, (at * v).dot(axis));
+    return least - t->getMargin();
+  }
+  btVector3 lo, hi;
+  piece->getAabb(at, lo, hi);
+  btScalar least = BT_LARGE_FLOAT;
+  for (int c = 0; c < 8; ++c) {
+    least = std::min(least, btVector3(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z()).dot(axis));
+  }
+  return least;
+}
 
 struct Overlapping : btBroadphaseAabbCallback {
   std::vector<const btCollisionObject*> objects;
@@ -418,11 +449,15 @@ struct CollisionWorld::Impl {
       for (const btCollisionObject* other : near) {
         // Only what is nearer than the nearest so far: the box shrinks as the search goes.
         const btScalar within = best ? static_cast<btScalar>(best->distance * kUnitsPerMetre) : threshold;
-        const btVector3 lo = box_lo - btVector3(within, within, within), hi = box_hi + btVector3(within, within, within);
+        btVector3 lo = box_lo - btVector3(within, within, within), hi = box_hi + btVector3(within, within, within);
+        cut_at_end(piece, lo, hi);
         const Body& b = bodies.at(other->getUserIndex());
         const btCollisionObject* exact = b.exact ? b.exact.get() : b.object.get();
         static_pieces(exact->getCollisionShape(), exact->getWorldTransform(), lo, hi,
                       [&](const btConvexShape* against, const btTransform& against_at) {
+                        if (piece.ends_at < BT_LARGE_FLOAT && begins_at(against, against_at, piece.ahead) > piece.ends_at) {
+                          return;
+                        }
                         const auto [distance, normal] = convex_distance(piece.shape, piece.at, against, against_at);
                         const double metres = distance / kUnitsPerMetre;
                         if (distance > threshold || (best && metres >= best->distance)) return;
@@ -510,46 +545,87 @@ std::optional<Clearance> CollisionWorld::nearest(const MovingBody& body, const P
 // Without turning, one distance per pair of pieces covers the whole move: the distance to a
 // child's swept volume (swept_hull) is the least it comes to along the move. Sampling took one
 // per pair and millimetre. A pair is judged where it comes nearest: one that closes head-on
-// at the move's end is a seat, which `counts` leaves out.
+// at the move's end is a seat, which `counts` leaves out. For the `closing` member, what lies
+// wholly beyond the end of a piece's sweep is not asked at all: the piece never comes beside
+// it, and a part lowered onto a concave one asked every pair of their facing triangles.
 std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& body, const Pose& from,
                                                              const Eigen::Vector3d& shift, double reach,
-                                                             const ClearanceFilter& counts) const {
+                                                             const ClearanceFilter& counts,
+                                                             const std::string& closing) const {
   ++checks_;
-  MovingBody::Impl::Shape& shape = body.impl_->has_exact ? body.impl_->exact_shape() : body.impl_->coarse;
+  const MovingBody::Impl& moving = *body.impl_;
+  const btCompoundShape& coarse = moving.coarse.compound;
   const btTransform at = to_bullet(from);
   btTransform end = at;
   end.setOrigin(at.getOrigin() + to_bullet(shift));
   const btVector3 local_shift = to_bullet(Eigen::Vector3d(from.linear().transpose() * shift));
+  const Eigen::Vector3d direction = shift.norm() > 0 ? Eigen::Vector3d(shift.normalized()) : Eigen::Vector3d::Zero();
+  const btVector3 ahead(direction.x(), direction.y(), direction.z());
   const btScalar threshold = static_cast<btScalar>(reach * kUnitsPerMetre);
   const btVector3 pad(threshold, threshold, threshold);
-  const auto swept_box = [&](const btCollisionShape& s, const btTransform& offset, btVector3& lo, btVector3& hi) {
-    btVector3 lo_end, hi_end;
-    s.getAabb(at * offset, lo, hi);
-    s.getAabb(end * offset, lo_end, hi_end);
-    lo.setMin(lo_end);
-    hi.setMax(hi_end);
-  };
-  btVector3 min, max;
-  swept_box(shape.compound, btTransform::getIdentity(), min, max);
+  btVector3 min, max, min_end, max_end;
+  coarse.getAabb(at, min, max);
+  coarse.getAabb(end, min_end, max_end);
   Overlapping near;
+  min.setMin(min_end);
+  max.setMax(max_end);
   impl_->broadphase.aabbTest(min - pad, max + pad, near);
   if (near.objects.empty()) return std::nullopt;
-  // Swept hulls only for the children that come within reach of a near body's box: a concave
-  // part's exact shape has a child per triangle.
+  // Piece by piece: each convex child, and a concave member's triangles (its exact shape,
+  // whose compound of 10k children took longer to build than the distances). Swept hulls
+  // only for the pieces that come within reach of a near body's box.
   std::vector<std::unique_ptr<btConvexHullShape>> hulls;
   std::vector<MovingPiece> pieces;
-  for (int i = 0; i < shape.compound.getNumChildShapes(); ++i) {
-    const btCollisionShape& child = *shape.compound.getChildShape(i);
-    const btTransform& offset = shape.compound.getChildTransform(i);
-    btVector3 lo, hi;
-    swept_box(child, offset, lo, hi);
+  std::vector<btVector3> points;  // a piece's corners and the same shifted, in the body's frame
+  const auto consider = [&](const std::string& member, btScalar margin) {
+    btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
+    for (const btVector3& p : points) {
+      lo.setMin(at * p);
+      hi.setMax(at * p);
+    }
+    const btVector3 grown = pad + btVector3(margin, margin, margin);
     const bool within_reach = std::any_of(near.objects.begin(), near.objects.end(), [&](const btCollisionObject* o) {
       const btBroadphaseProxy* proxy = o->getBroadphaseHandle();
-      return TestAabbAgainstAabb2(lo - pad, hi + pad, proxy->m_aabbMin, proxy->m_aabbMax);
+      return TestAabbAgainstAabb2(lo - grown, hi + grown, proxy->m_aabbMin, proxy->m_aabbMax);
     });
-    if (!within_reach) continue;
-    hulls.push_back(swept_hull(child, offset, local_shift));
-    pieces.push_back({hulls.back().get(), at, &shape.member_of_child[static_cast<std::size_t>(i)]});
+    if (!within_reach) return;
+    hulls.push_back(std::make_unique<btConvexHullShape>(&points[0].getX(), static_cast<int>(points.size())));
+    hulls.back()->setMargin(margin);
+    MovingPiece piece{hulls.back().get(), at, &member};
+    if (member == closing && ahead.length2() > 0) {
+      piece.ahead = ahead;
+      piece.ends_at = -BT_LARGE_FLOAT;
+      for (const btVector3& p : points) piece.ends_at = std::max(piece.ends_at, (at * p).dot(ahead));
+      piece.ends_at += margin;
+    }
+    pieces.push_back(piece);
+  };
+  for (int i = 0; i < coarse.getNumChildShapes(); ++i) {
+    const btTransform& offset = coarse.getChildTransform(i);
+    const std::string& member = moving.coarse.member_of_child[static_cast<std::size_t>(i)];
+    const auto& triangles = moving.triangles_of_child[static_cast<std::size_t>(i)];
+    if (triangles.empty()) {
+      // A box's corners hold its margin, so its hull keeps the box's surface where grown_by
+      // adds the margin back; a hull's points leave it out, as the hull's own margin does.
+      const auto& child = static_cast<const btPolyhedralConvexShape&>(*coarse.getChildShape(i));
+      points.clear();
+      for (int v = 0; v < child.getNumVertices(); ++v) {
+        btVector3 p;
+        child.getVertex(v, p);
+        points.push_back(offset * p);
+        points.push_back(offset * p + local_shift);
+      }
+      consider(member, child.getMargin());
+      continue;
+    }
+    for (const auto& t : triangles) {
+      points.clear();
+      for (const btVector3& corner : t) {
+        points.push_back(offset * corner);
+        points.push_back(offset * corner + local_shift);
+      }
+      consider(member, static_cast<btScalar>(moving.margin));
+    }
   }
   return impl_->nearest_of(pieces, near.objects, threshold, counts);
 }
@@ -634,7 +710,8 @@ std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose&
 }
 
 std::optional<Clearance> CollisionWorld::nearest_along(const MovingBody& body, const Pose& from, const Pose& to,
-                                                       double reach, const ClearanceFilter& counts) const {
+                                                       double reach, const ClearanceFilter& counts,
+                                                       const std::string& closing) const {
   const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
   const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
   const bool translating = angle < 1e-9;
@@ -663,7 +740,7 @@ std::optional<Clearance> CollisionWorld::nearest_along(const MovingBody& body, c
     if (!overlap.found) return;
     const double length = (s1 - s0) * travel;
     if (translating && length <= std::max(4 * reach, options_.linear_step)) {
-      keep(nearest_translating(body, a, b.translation() - a.translation(), within(), counts));
+      keep(nearest_translating(body, a, b.translation() - a.translation(), within(), counts, closing));
       return;
     }
     if (!translating && length <= options_.linear_step) {

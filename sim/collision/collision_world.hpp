@@ -105,16 +105,19 @@ class CollisionWorld {
                                    const ClearanceFilter& counts = {}) const;
   // The same along a move: exact for a move without turning (each piece's swept volume);
   // with turning, sampled so that no point moves more than linear_step between samples.
-  // Stretches farther than `reach` from every body are skipped whole.
+  // Stretches farther than `reach` from every body are skipped whole. `closing`: the member
+  // that the move brings to its seat; where the move does not turn, what lies wholly beyond
+  // where its pieces end up, along the move, is left out (it never comes beside them).
   std::optional<Clearance> nearest_along(const MovingBody& body, const Pose& from, const Pose& to, double reach,
-                                         const ClearanceFilter& counts = {}) const;
+                                         const ClearanceFilter& counts = {}, const std::string& closing = "") const;
   // Penetration tests made so far (for benchmarks).
   std::size_t checks() const { return checks_; }
 
  private:
   bool clear_translation(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift) const;
   std::optional<Clearance> nearest_translating(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift,
-                                               double reach, const ClearanceFilter& counts) const;
+                                               double reach, const ClearanceFilter& counts,
+                                               const std::string& closing) const;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -202,3 +202,23 @@ TEST_CASE("clearance along a move without turning is its least, between samples 
   INFO("least " << past->distance * 1000 << " mm");
   CHECK(past->distance == Approx(0.0002).margin(3e-5));
 }
+
+TEST_CASE("clearance of a closing member leaves out what lies beyond the end of its move", "[collision][margin]") {
+  sim::CollisionWorld world;
+  world.add_static_box("floor", {0.1, 0.01, 0.1}, at(0, -0.01, 0));
+  const auto cube = box_body({0.01, 0.01, 0.01}, world);
+  // Lowered to 1 mm above the floor: head-on, the floor is the nearest.
+  const auto down = world.nearest_along(cube, at(0, 0.05, 0), at(0, 0.011, 0), 0.01);
+  REQUIRE(down);
+  CHECK(down->body_name == "floor");
+  CHECK(down->distance == Approx(0.001).margin(1e-5));
+  // The part closes on it: it never comes beside the floor, which is not asked.
+  CHECK_FALSE(world.nearest_along(cube, at(0, 0.05, 0), at(0, 0.011, 0), 0.01, {}, "part"));
+  CHECK(world.nearest_along(cube, at(0, 0.05, 0), at(0, 0.011, 0), 0.01, {}, "finger"));  // another member's
+  // A post beside the way down, 0.5 mm from the cube's side, is beside it.
+  world.add_static_box("post", {0.005, 0.02, 0.005}, at(0.0155, 0.02, 0));
+  const auto beside = world.nearest_along(cube, at(0, 0.05, 0), at(0, 0.011, 0), 0.01, {}, "part");
+  REQUIRE(beside);
+  CHECK(beside->body_name == "post");
+  CHECK(beside->distance == Approx(0.0005).margin(1e-5));
+}

@@ -161,7 +161,7 @@ std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& tr
       const double length = (to.translation() - w[i - 1].part.translation()).norm();
       if (length > 0) to = sim::interpolate(w[i - 1].part, to, 1 - std::min(kShortOfSeat, length / 2) / length);
     }
-    const auto c = world_.nearest_along(held.with_arm, w[i - 1].part, to, reach, counts);
+    const auto c = world_.nearest_along(held.with_arm, w[i - 1].part, to, reach, counts, "part");
     if (!c || (least && c->distance >= least->distance)) continue;
     const auto name = names_.find(c->body);
     least = Margin{c->distance, name == names_.end() ? c->body_name : name->second, c->member, w[i].phase};
