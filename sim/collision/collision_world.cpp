@@ -93,22 +93,26 @@ double grown_by(const btCollisionShape* shape) {
   return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
 }
 
-// The volume a convex child (box, hull or triangle) at `offset` sweeps while its body moves by
-// `shift` (in the body's frame) without turning: the hull of its corners and the same corners
-// shifted, which is exactly that volume. A box's corners hold its margin, so its hull keeps
-// the box's surface where grown_by adds the margin back.
-std::unique_ptr<btConvexHullShape> swept_hull(const btCollisionShape& child, const btTransform& offset,
-                                              const btVector3& shift) {
+// The corners of a convex child (box, hull or triangle) at `offset` and the same corners
+// shifted by `shift` (in its body's frame): their hull is exactly the volume the child sweeps
+// while the body moves by `shift` without turning. A box's corners hold its margin, so its
+// hull keeps the box's surface where grown_by adds the margin back; a hull's points leave the
+// margin out, as the hull's own margin does.
+void swept_corners(const btCollisionShape& child, const btTransform& offset, const btVector3& shift,
+                   std::vector<btVector3>& points) {
   const auto& polyhedron = static_cast<const btPolyhedralConvexShape&>(child);
-  auto hull = std::make_unique<btConvexHullShape>();
+  points.clear();
   for (int v = 0; v < polyhedron.getNumVertices(); ++v) {
     btVector3 p;
     polyhedron.getVertex(v, p);
-    hull->addPoint(offset * p, false);
-    hull->addPoint(offset * p + shift, false);
+    points.push_back(offset * p);
+    points.push_back(offset * p + shift);
   }
-  hull->recalcLocalAabb();
-  hull->setMargin(child.getMargin());
+}
+
+std::unique_ptr<btConvexHullShape> hull_of_points(const std::vector<btVector3>& points, btScalar margin) {
+  auto hull = std::make_unique<btConvexHullShape>(&points[0].getX(), static_cast<int>(points.size()));
+  hull->setMargin(margin);
   return hull;
 }
 
@@ -543,7 +547,7 @@ std::optional<Clearance> CollisionWorld::nearest(const MovingBody& body, const P
 }
 
 // Without turning, one distance per pair of pieces covers the whole move: the distance to a
-// child's swept volume (swept_hull) is the least it comes to along the move. Sampling took one
+// child's swept volume (swept_corners) is the least it comes to along the move. Sampling took one
 // per pair and millimetre. A pair is judged where it comes nearest: one that closes head-on
 // at the move's end is a seat, which `counts` leaves out. For the `closing` member, what lies
 // wholly beyond the end of a piece's sweep is not asked at all: the piece never comes beside
@@ -589,8 +593,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
       return TestAabbAgainstAabb2(lo - grown, hi + grown, proxy->m_aabbMin, proxy->m_aabbMax);
     });
     if (!within_reach) return;
-    hulls.push_back(std::make_unique<btConvexHullShape>(&points[0].getX(), static_cast<int>(points.size())));
-    hulls.back()->setMargin(margin);
+    hulls.push_back(hull_of_points(points, margin));
     MovingPiece piece{hulls.back().get(), at, &member};
     if (member == closing && ahead.length2() > 0) {
       piece.ahead = ahead;
@@ -605,17 +608,8 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
     const std::string& member = moving.coarse.member_of_child[static_cast<std::size_t>(i)];
     const auto& triangles = moving.triangles_of_child[static_cast<std::size_t>(i)];
     if (triangles.empty()) {
-      // A box's corners hold its margin, so its hull keeps the box's surface where grown_by
-      // adds the margin back; a hull's points leave it out, as the hull's own margin does.
-      const auto& child = static_cast<const btPolyhedralConvexShape&>(*coarse.getChildShape(i));
-      points.clear();
-      for (int v = 0; v < child.getNumVertices(); ++v) {
-        btVector3 p;
-        child.getVertex(v, p);
-        points.push_back(offset * p);
-        points.push_back(offset * p + local_shift);
-      }
-      consider(member, child.getMargin());
+      swept_corners(*coarse.getChildShape(i), offset, local_shift, points);
+      consider(member, coarse.getChildShape(i)->getMargin());
       continue;
     }
     for (const auto& t : triangles) {
@@ -642,15 +636,17 @@ struct AnyOverlap : btBroadphaseAabbCallback {
 
 }  // namespace
 
-// The coarse body's swept volume (swept_hull, child by child) holds it at every pose of the
+// The coarse body's swept volume (swept_corners, child by child) holds it at every pose of the
 // move, so it reaches at least as deep as any of them: when it is clear, so is the whole move.
 bool CollisionWorld::clear_translation(const MovingBody& body, const Pose& from, const Eigen::Vector3d& shift) const {
   const btCompoundShape& coarse = body.impl_->coarse.compound;
   const btVector3 d = to_bullet(shift);
   btCompoundShape swept(true, coarse.getNumChildShapes());
   std::vector<std::unique_ptr<btConvexHullShape>> hulls;
+  std::vector<btVector3> points;
   for (int i = 0; i < coarse.getNumChildShapes(); ++i) {
-    hulls.push_back(swept_hull(*coarse.getChildShape(i), coarse.getChildTransform(i), d));
+    swept_corners(*coarse.getChildShape(i), coarse.getChildTransform(i), d, points);
+    hulls.push_back(hull_of_points(points, coarse.getChildShape(i)->getMargin()));
     swept.addChildShape(btTransform::getIdentity(), hulls.back().get());
   }
   btCollisionObject object;
@@ -724,9 +720,9 @@ std::optional<Clearance> CollisionWorld::nearest_along(const MovingBody& body, c
   // Only what is nearer than the nearest so far matters: Bullet then leaves more pairs out.
   const auto within = [&] { return best ? best->distance : reach; };
   // As sweep: a stretch whose box, grown by the reach, overlaps no body is skipped. The rest
-  // is halved: without turning, down to stretches of the reach, each measured whole
-  // (nearest_translating; shorter stretches keep its boxes small); else down to linear_step,
-  // sampled at its ends.
+  // is halved: without turning, down to stretches of four times the reach, each measured
+  // whole (nearest_translating; shorter stretches keep its boxes small); else down to
+  // linear_step, sampled at its ends.
   auto visit = [&](auto&& self, double s0, double s1) -> void {
     const Pose a = interpolate(from, to, s0), b = interpolate(from, to, s1);
     btVector3 min_a, max_a, min_b, max_b;
