@@ -582,6 +582,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
   std::vector<MovingPiece> pieces;
   std::vector<btVector3> points;  // a piece's corners and the same shifted, in the body's frame
   const auto consider = [&](const std::string& member, btScalar margin) {
+    if (points.empty()) return;
     btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
     for (const btVector3& p : points) {
       lo.setMin(at * p);
