@@ -222,6 +222,11 @@ void CellStore::give(const std::string& buffer, const std::string& type, const s
   t.commit();
 }
 
+void CellStore::put_back(const PartRecord& p) {
+  Statement(db_, "UPDATE stock SET count = count + 1 WHERE buffer = ? AND part_type = ?").bind(p.buffer, p.part_type).step();
+  Statement(db_, "UPDATE parts SET place = 'returned', holder = '' WHERE order_id = ? AND part = ?").bind(p.order, p.part).step();
+}
+
 bool CellStore::given(const std::string& buffer, const std::string& order, const std::string& part,
                       const std::string& carrier) const {
   Statement row(db_, "SELECT 1 FROM parts WHERE order_id = ? AND part = ? AND buffer = ? AND holder = ? "
@@ -239,12 +244,9 @@ std::vector<PartRecord> CellStore::undo_unanswered_gives(const std::string& buff
   std::vector<PartRecord> undone;
   while (rows.step()) undone.push_back({rows.text(0), rows.text(1), rows.text(2), buffer, rows.text(3), Place::in_transit, ""});
   for (const auto& p : undone) {
-    Statement(db_, "UPDATE stock SET count = count + 1 WHERE buffer = ? AND part_type = ?").bind(buffer, p.part_type).step();
+    put_back(p);
     Statement(db_, "UPDATE kept SET count = count + 1 WHERE buffer = ? AND order_id = ? AND part_type = ?")
         .bind(buffer, p.order, p.part_type)
-        .step();
-    Statement(db_, "UPDATE parts SET place = 'returned', holder = '' WHERE order_id = ? AND part = ?")
-        .bind(p.order, p.part)
         .step();
   }
   t.commit();
@@ -337,12 +339,7 @@ std::vector<PartRecord> CellStore::parts_held(const std::string& holder, Place p
 std::vector<PartRecord> CellStore::return_carried(const std::string& carrier) {
   Transaction t(*this);
   const std::vector<PartRecord> carried = parts_held(carrier, Place::in_transit);
-  for (const auto& p : carried) {
-    Statement(db_, "UPDATE stock SET count = count + 1 WHERE buffer = ? AND part_type = ?").bind(p.buffer, p.part_type).step();
-    Statement(db_, "UPDATE parts SET place = 'returned', holder = '' WHERE order_id = ? AND part = ?")
-        .bind(p.order, p.part)
-        .step();
-  }
+  for (const auto& p : carried) put_back(p);
   t.commit();
   return carried;
 }

@@ -164,6 +164,8 @@ class CellStore {
   class Transaction;
   void exec(const char* sql) const;
   void add_columns_of_later_versions();
+  // The part, on its way, goes back to the buffer it came from (within a transaction).
+  void put_back(const PartRecord& part);
   std::vector<PartRecord> parts_held(const std::string& holder, Place place) const;
   void move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
                  const char* from);

@@ -300,7 +300,7 @@ void MovingBody::add_mesh(const std::string& member, const TriangleMesh& mesh, c
   for (std::size_t piece = 0; piece < mesh.pieces.size(); ++piece) {
     for (auto index : mesh.pieces[piece]) radius_ = std::max(radius_, (offset * mesh.vertices[index]).norm());
     auto hull = hull_of(mesh, piece, margin);
-    if (mesh.pieces.size() > 1 || mesh.convex) {  // convex pieces, or convex: the hull is exact
+    if (pieces_are_exact(mesh)) {
       impl_->add(member, std::move(hull), to_bullet(offset));
       continue;
     }
@@ -384,7 +384,7 @@ struct CollisionWorld::Impl {
     SharedMesh& shared = it->second;
     if (!inserted) return shared.shape.get();
     shared.mesh = mesh;
-    if (mesh->pieces.size() > 1 || mesh->convex) {
+    if (pieces_are_exact(*mesh)) {
       auto compound = std::make_unique<btCompoundShape>(true, static_cast<int>(mesh->pieces.size()));
       for (std::size_t piece = 0; piece < mesh->pieces.size(); ++piece) {
         auto hull = hull_of(*mesh, piece, margin);
@@ -581,12 +581,15 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
   std::vector<std::unique_ptr<btConvexHullShape>> hulls;
   std::vector<MovingPiece> pieces;
   std::vector<btVector3> points;  // a piece's corners and the same shifted, in the body's frame
+  std::vector<btVector3> in_world;
   const auto consider = [&](const std::string& member, btScalar margin) {
     if (points.empty()) return;
+    in_world.clear();
     btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
     for (const btVector3& p : points) {
-      lo.setMin(at * p);
-      hi.setMax(at * p);
+      in_world.push_back(at * p);
+      lo.setMin(in_world.back());
+      hi.setMax(in_world.back());
     }
     const btVector3 grown = pad + btVector3(margin, margin, margin);
     const bool within_reach = std::any_of(near.objects.begin(), near.objects.end(), [&](const btCollisionObject* o) {
@@ -599,7 +602,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
     if (member == closing && ahead.length2() > 0) {
       piece.ahead = ahead;
       piece.ends_at = -BT_LARGE_FLOAT;
-      for (const btVector3& p : points) piece.ends_at = std::max(piece.ends_at, (at * p).dot(ahead));
+      for (const btVector3& p : in_world) piece.ends_at = std::max(piece.ends_at, p.dot(ahead));
       piece.ends_at += margin;
     }
     pieces.push_back(piece);

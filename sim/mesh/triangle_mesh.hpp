@@ -50,6 +50,9 @@ struct TriangleMesh {
 
 // Whether the mesh is one closed convex piece: its volume is its hull's (to 0.1 %).
 bool is_convex(const TriangleMesh& mesh);
+// Whether the hulls of its pieces are the mesh (authored as convex pieces, or one convex
+// piece); otherwise it is one piece that may be concave, whose triangles are its shape.
+inline bool pieces_are_exact(const TriangleMesh& mesh) { return mesh.pieces.size() > 1 || mesh.convex; }
 // Each piece's vertices on its convex hull (all of them for a flat or degenerate piece).
 std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh);
 constexpr std::size_t kCoarseCorners = 256;

@@ -124,9 +124,13 @@ class Search {
 
   double margin_of(const PlanStep& step) const { return step.margin ? step.margin->distance : options_.margin_reach; }
 
+  bool too_large_to_measure(PartIndex part) const {
+    return scene_.exact_triangles(part) > options_.margin_max_triangles;
+  }
+
   void measure(PlanStep& step) const {
     if (options_.margin_reach <= 0) return;  // margins not asked for
-    if (scene_.exact_triangles(step.part) > options_.margin_max_triangles) return;
+    if (too_large_to_measure(step.part)) return;
     step.margin = scene_.margin(step.part, step.trajectory, options_.margin_reach);
     step.margin_measured = true;
   }
@@ -237,7 +241,7 @@ class Search {
     }
     for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
       const PlanStep& step = plan_.steps[i];
-      if (options_.margin_reach > 0 && !step.margin_measured) {
+      if (options_.margin_reach > 0 && too_large_to_measure(step.part)) {
         plan_.findings.push_back({"margin",
                                   "step " + std::to_string(i + 1) + " (" + name(step.part) + "): margin not measured: " +
                                       "one concave piece of " + std::to_string(scene_.exact_triangles(step.part)) +

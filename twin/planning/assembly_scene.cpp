@@ -171,7 +171,7 @@ std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& tr
 
 std::size_t AssemblyScene::exact_triangles(PartIndex part) const {
   const auto& mesh = product_.meshes[part];
-  return mesh && mesh->pieces.size() == 1 && !mesh->convex ? mesh->triangles.size() : 0;
+  return mesh && !sim::pieces_are_exact(*mesh) ? mesh->triangles.size() : 0;
 }
 
 Collision AssemblyScene::to_collision(const sim::Contact& contact, const std::string& phase) const {

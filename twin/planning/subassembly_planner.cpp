@@ -162,7 +162,7 @@ std::shared_ptr<const sim::TriangleMesh> merged_mesh(const LoadedProduct& produc
       out->bounds.extend(out->vertices.back());
     }
     for (const auto& t : mesh->triangles) out->triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
-    if (mesh->pieces.size() > 1 || mesh->convex) {
+    if (sim::pieces_are_exact(*mesh)) {
       for (const auto& piece : mesh->pieces) {
         out->pieces.emplace_back();
         for (auto v : piece) out->pieces.back().push_back(v + first);
