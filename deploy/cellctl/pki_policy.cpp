@@ -1,5 +1,6 @@
 #include "deploy/cellctl/pki_policy.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "deploy/cellctl/file_transfer.hpp"
@@ -49,11 +50,16 @@ void criteria_xml(std::ostream& out, const char* tag, const Topics& topics, cons
   out << "        </" << tag << ">\n";
 }
 
-// The owned topics (dds::owned_topic) in the identity's own partitions when it writes them,
-// in every partition when it reads them; the others in the default partition.
-void topics_xml(std::ostream& out, const char* tag, const Topics& topics, const Topics& owned_partitions) {
+// The owned topics (dds::owned_topic) and those it speaks on as itself in the identity's own
+// partitions when it writes them, in every partition when it reads them; the others in the
+// default partition.
+void topics_xml(std::ostream& out, const char* tag, const Topics& topics, const Topics& owned_partitions,
+                const Topics& as_itself) {
   Topics owned, other;
-  for (const auto& t : topics) (dds::owned_topic(t) ? owned : other).push_back(t);
+  for (const auto& t : topics) {
+    const bool own = dds::owned_topic(t) || std::find(as_itself.begin(), as_itself.end(), t) != as_itself.end();
+    (own ? owned : other).push_back(t);
+  }
   criteria_xml(out, tag, other, {});
   criteria_xml(out, tag, owned, owned_partitions);
 }
@@ -73,11 +79,13 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
   Topics buffers;
   for (const auto& b : cell.buffers) {
     grants.push_back(resource(b.id, "buffer", {commands(b.id)}, false));
+    grants.back().as_itself = {commands(b.id)};
     buffers.push_back(commands(b.id));
   }
   for (const auto& r : cell.robots) {
     Grant g = resource(r.id, "mobile-robot", {commands(r.id)}, true);
     g.publish = g.publish + buffers;  // the robot has buffers give it parts
+    g.as_itself = buffers;
     g.subscribe = g.subscribe + Topics{"cell/capabilities", "cell/command_events"};
     grants.push_back(g);
     commanded.push_back(commands(r.id));
@@ -153,8 +161,8 @@ std::string permissions_xml(const Grant& grant, int domain, const Validity& vali
           <id>)" << domain << R"(</id>
         </domains>
 )";
-  topics_xml(out, "publish", grant.publish, grant.own_partitions);
-  topics_xml(out, "subscribe", grant.subscribe, {"*"});
+  topics_xml(out, "publish", grant.publish, grant.own_partitions, grant.as_itself);
+  topics_xml(out, "subscribe", grant.subscribe, {"*"}, grant.as_itself);
   out << R"(      </allow_rule>
       <default>DENY</default>
     </grant>

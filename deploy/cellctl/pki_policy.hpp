@@ -16,6 +16,10 @@ struct Grant {
   std::string role;      // cell-sim, station, mobile-robot, buffer, twin, cellctl, order-desk, client
   std::vector<std::string> own_partitions;  // the ids it writes its capability and command events as
   std::vector<std::string> publish, subscribe;
+  // Besides the owned topics (dds::owned_topic), the topics in partitions: written in its own
+  // ones only, read in every one. A robot's gives to buffers; a buffer's commands, which it
+  // takes from the robot they name alone.
+  std::vector<std::string> as_itself = {};
 };
 
 // One per process of the cell (cell-sim, each station, robot and buffer), one for every twin

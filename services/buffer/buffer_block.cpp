@@ -56,7 +56,8 @@ void BufferBlock::check(const Data& command, SampleCheck& c) const {
   if (get<std::string>(command, "operation") != "give") return;
   if (get_or<std::string>(command, "part", "").empty()) c.text("part_type", true);
   // The durable state records who took the part: a robot that restarts gives back what its
-  // record says it carried. (That the sender is that robot is DDS-Security's to prove.)
+  // record says it carried. (That the sender is that robot, DDS-Security proves: its partition,
+  // NodeConfig::commanded_by_destination.)
   c.text("destination", true);
 }
 

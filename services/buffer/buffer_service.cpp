@@ -10,6 +10,7 @@ BufferService::BufferService(BufferConfig config) : resource_(config.node.id, 25
   config.node.offers = {"give"};
   // Robots ask at the same time: gives wait their turn (each is done at once).
   config.node.when_busy = fb::CommandLifecycle::WhenBusy::queue;
+  config.node.commanded_by_destination = true;  // the robot that takes the part
   config.node.dock = config.node.position;
   auto& buffer = resource_.add(std::make_unique<fb::BufferBlock>("buffer", config.node.id, config.stock));
   const std::string id = config.node.id;

@@ -61,6 +61,10 @@ struct has_resource_id : std::false_type {};
 template <class T>
 struct has_resource_id<T, std::void_t<decltype(std::declval<const T&>().resource_id())>> : std::true_type {};
 
+// The resource a sample speaks for (Reader): its writer must write in that resource's partition.
+template <class T>
+using Speaker = std::function<std::string(const T&)>;
+
 // Settings with the partition(s) `owner` writes an owned topic in.
 inline QosSettings owned_by(std::vector<std::string> owner, QosSettings settings = {}) {
   settings.partitions = std::move(owner);
@@ -225,13 +229,20 @@ class Reader : private fdds::DataReaderListener {
   // Called on Fast DDS's listener thread: `on_sample` for each new sample; on state topics,
   // `on_gone` with an instance's last sample when its writers are gone (liveliness lost,
   // process ended) or it was disposed.
+  // `speaker`: the resource a sample speaks for, whose partition its writer must write in for
+  // it to count under access control (owned topics: the sample's resource_id). The reader then
+  // reads every partition.
   Reader(ParticipantPtr participant, const std::string& topic, TopicKind kind, std::function<void(const T&)> on_sample,
-         std::function<void(const T&)> on_gone = {}, const QosSettings& settings = {})
-      : participant_(std::move(participant)), kind_(kind), on_sample_(std::move(on_sample)), on_gone_(std::move(on_gone)) {
+         std::function<void(const T&)> on_gone = {}, const QosSettings& settings = {}, Speaker<T> speaker = {})
+      : participant_(std::move(participant)), kind_(kind), speaker_(std::move(speaker)), on_sample_(std::move(on_sample)),
+        on_gone_(std::move(on_gone)) {
+    if constexpr (has_resource_id<T>::value) {
+      if (!speaker_ && owned_topic(topic)) speaker_ = [](const T& s) { return s.resource_id().to_string(); };
+    }
     subscriber_ = participant_->create_subscriber(with_partitions(
-        fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && owned_topic(topic) ? every_partition(*participant_)
-                                                                                        : settings.partitions));
-    check_writers_ = owned_topic(topic) && access_controlled(*participant_);
+        fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && speaker_ ? every_partition(*participant_)
+                                                                              : settings.partitions));
+    check_writers_ = speaker_ && access_controlled(*participant_);
     topic_ = topic;
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
@@ -304,25 +315,24 @@ class Reader : private fdds::DataReaderListener {
     }
   }
 
-  // Under DDS-Security a resource may write an owned topic in its own partition only; a sample
-  // it wrote there about another resource is dropped (the writer said once, on stderr).
+  // Under DDS-Security a resource may write an owned topic (or one it speaks on for itself) in
+  // its own partition only; a sample it wrote there for another resource is dropped (the
+  // writer said once, on stderr).
   bool from_its_owner(const T& sample, const fdds::SampleInfo& info) {
-    if constexpr (has_resource_id<T>::value) {
-      if (!check_writers_) return true;
-      const auto writer = info.sample_identity.writer_guid();
-      if (writer_speaks_for(*participant_, writer, sample.resource_id().to_string())) return true;
-      if (impostors_.insert(writer).second) {
-        std::cerr << "dropped a sample on " << topic_ << " about '" << sample.resource_id() << "' from writer " << writer
-                  << ", which DDS-Security lets write only about another resource\n";
-      }
-      return false;
-    } else {
-      return true;
+    if (!check_writers_) return true;
+    const auto writer = info.sample_identity.writer_guid();
+    const std::string speaker = speaker_(sample);
+    if (writer_speaks_for(*participant_, writer, speaker)) return true;
+    if (impostors_.insert(writer).second) {
+      std::cerr << "dropped a sample on " << topic_ << " for '" << speaker << "' from writer " << writer
+                << ", which DDS-Security lets write only for another resource\n";
     }
+    return false;
   }
 
   ParticipantPtr participant_;
   TopicKind kind_;
+  Speaker<T> speaker_;
   bool check_writers_ = false;
   std::string topic_;
   std::set<eprosima::fastrtps::rtps::GUID_t> impostors_;  // used by the draining thread only

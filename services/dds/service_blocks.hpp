@@ -76,7 +76,7 @@ class SubscribeBlock : public fb::FunctionBlock {
   void start() {
     reader_ = std::make_unique<Reader<T, PubSubType>>(
         participant_, topic_, kind_, [this](const T& s) { deliver("RECEIVED", s); },
-        [this](const T& s) { deliver("LOST", s); }, settings_);
+        [this](const T& s) { deliver("LOST", s); }, settings_, speaker_);
   }
 
   void receive(const fb::Event& event) override {
@@ -86,6 +86,8 @@ class SubscribeBlock : public fb::FunctionBlock {
 
   // Set before start().
   void on_refused(std::function<void(const T&, const std::string& why)> refused) { on_refused_ = std::move(refused); }
+  // Set before start(): samples count only from a writer that speaks for that resource (Reader).
+  void written_by(Speaker<T> speaker) { speaker_ = std::move(speaker); }
 
  private:
   void deliver(const char* input, const T& sample) {
@@ -113,6 +115,7 @@ class SubscribeBlock : public fb::FunctionBlock {
   ToData to_data_;
   QosSettings settings_;
   std::function<void(const T&, const std::string&)> on_refused_;
+  Speaker<T> speaker_;
   std::unique_ptr<Reader<T, PubSubType>> reader_;
 };
 

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
         }));
     resource.add(std::make_unique<dds::RoutedPublishBlock<cell::Command, cell::CommandPubSubType>>(
         "gives", participant, [](const fb::Data& d) { return dds::command_topic(fb::get<std::string>(d, "resource_id")); },
-        [](const fb::Data& d) { return dds::to_command(d); }, dds::command_qos()));
+        [](const fb::Data& d) { return dds::to_command(d); }, dds::owned_by({config.id}, dds::command_qos())));
     resource.connect("places", "IND", "robot", "PLACE");
     resource.connect("give_events", "IND", "robot", "GIVE_EVENT");
     resource.connect("robot", "GIVE", "gives", "REQ");

@@ -285,6 +285,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
       "commands", dds::command_topic(me), TopicKind::events,
       [me](const cell::Command& c) { return c.resource_id().to_string() == me ? dds::to_data(c) : fb::Data{}; },
       dds::command_qos());
+  if (n.config.commanded_by_destination) commands.written_by([](const cell::Command& c) { return c.destination().to_string(); });
   n.overflow_answers = std::make_unique<dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType>>(
       participant, "cell/command_events", TopicKind::events, dds::owned_by({n.config.id}));
   commands.on_refused([&n](const cell::Command& c, const std::string& why) {

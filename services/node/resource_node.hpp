@@ -52,6 +52,10 @@ struct NodeConfig {
   double liveliness_lease_s = 5.0;
   fb::CellBounds bounds;     // commands' positions must lie inside
   fb::CommandLifecycle::WhenBusy when_busy = fb::CommandLifecycle::WhenBusy::reject;
+  // Its commands come from the resource each names as its destination (a buffer's gives: the
+  // robot that takes the part), which writes them in its own partition; under DDS-Security a
+  // command that another wrote is dropped.
+  bool commanded_by_destination = false;
   // The cell's durable state (services/state): "" keeps everything in memory alone.
   std::string state_dir;
 };

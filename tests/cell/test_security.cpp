@@ -8,7 +8,9 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include <catch2/catch.hpp>
@@ -102,9 +104,12 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
   // By role: a buffer reads its own commands only and commands nobody; a twin commands the arm
   // and the robot but publishes no capability; cellctl only reads.
   const auto permissions = [&](const std::string& id) { return test::read_text(pki / "identities" / id / "permissions.xml"); };
-  const auto section = [](const std::string& xml, const std::string& tag) {
-    const auto from = xml.find("<" + tag + ">"), to = xml.find("</" + tag + ">");
-    return from == std::string::npos ? std::string() : xml.substr(from, to - from);
+  const auto section = [](const std::string& xml, const std::string& tag) {  // every one of them
+    std::string all;
+    for (auto from = xml.find("<" + tag + ">"); from != std::string::npos; from = xml.find("<" + tag + ">", from + 1)) {
+      all += xml.substr(from, xml.find("</" + tag + ">", from) - from);
+    }
+    return all;
   };
   CHECK(section(permissions("buffer-1"), "subscribe").find("cell/commands/buffer-1") != std::string::npos);
   CHECK(permissions("buffer-1").find("cell/commands/buffer-2") == std::string::npos);
@@ -113,6 +118,12 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
   CHECK(section(permissions("twin"), "publish").find("cell/capabilities") == std::string::npos);
   CHECK(section(permissions("cellctl"), "publish").empty());
   CHECK(section(permissions("mobile-robot-1"), "publish").find("cell/commands/buffer-1") != std::string::npos);
+  // A robot writes its gives in its own partition, and a buffer reads its commands in every one
+  // (it checks that a give comes from the robot it names).
+  CHECK(permissions("mobile-robot-1").find("<topic>cell/commands/buffer-2</topic>\n          </topics>\n          <partitions>\n"
+                                           "            <partition>mobile-robot-1</partition>") != std::string::npos);
+  CHECK(permissions("buffer-1").find("<topic>cell/commands/buffer-1</topic>\n          </topics>\n          <partitions>\n"
+                                     "            <partition>*</partition>") != std::string::npos);
 
   // A cell keeps its CA: a second init refuses and changes nothing.
   const std::string ca_key = test::read_text(pki / "ca.key.pem");
@@ -198,6 +209,50 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
       std::this_thread::sleep_for(500ms);
     }
     CHECK_FALSE(trusted_sees.saw_part_type("Forged"));
+  }
+
+  {  // A robot has buffers give it parts, in its own partition: it cannot write there as
+     // another robot, and a buffer drops a give that names another robot as the taker (its
+     // durable record would say that robot holds the part). One that names the writer reaches
+     // the buffer, which refuses it: no order holds the buffer.
+    auto as_robot = dds::make_participant("test-robot", {std::stoi(domain), true, {pki, "mobile-robot-1"}});
+    using CommandWriter = dds::Writer<cell::Command, cell::CommandPubSubType>;
+    CHECK_THROWS_WITH((CommandWriter(as_robot, dds::command_topic("buffer-1"), dds::TopicKind::events,
+                                     dds::owned_by({"mobile-robot-2"}, dds::command_qos()))),
+                      Catch::Contains("cannot create a writer on cell/commands/buffer-1: this identity's DDS-Security"));
+    std::mutex mutex;
+    std::map<std::string, std::string> answers;  // command id -> reason
+    dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
+        trusted, "cell/command_events", dds::TopicKind::events, [&](const cell::CommandEvent& e) {
+          std::lock_guard<std::mutex> lock(mutex);
+          answers[e.command_id().to_string()] = e.reason().to_string();
+        });
+    CommandWriter gives(as_robot, dds::command_topic("buffer-1"), dds::TopicKind::events,
+                        dds::owned_by({"mobile-robot-1"}, dds::command_qos()));
+    REQUIRE(gives.wait_for_readers(1, 10s));
+    cell::Command give;
+    give.resource_id("buffer-1");
+    give.order_id("nobody");
+    give.operation("give");
+    give.part("nobody/p1");
+    give.part_type("Brick2x4");
+    give.command_id("forged/give");
+    give.destination("mobile-robot-2");
+    gives.write(give);
+    give.command_id("own/give");
+    give.destination("mobile-robot-1");
+    gives.write(give);
+    const auto answered = [&](const std::string& id) {
+      std::lock_guard<std::mutex> lock(mutex);
+      return answers.count(id) ? std::optional<std::string>(answers.at(id)) : std::nullopt;
+    };
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (!answered("own/give") && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+    INFO(up_log());
+    REQUIRE(answered("own/give"));
+    CHECK(answered("own/give")->find("names no award of buffer-1") != std::string::npos);
+    CHECK_FALSE(answered("forged/give"));
+    CHECK(test::appears(dir / "up.log", "dropped a sample on cell/commands/buffer-1 for 'mobile-robot-2'", 10s));
   }
 
   {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.
