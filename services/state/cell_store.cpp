@@ -20,6 +20,7 @@ CREATE TABLE IF NOT EXISTS parts(
   place TEXT NOT NULL CHECK(place IN ('in_transit','on_station','in_gripper','placed','assembled','inspection',
                                      'returned')),
   holder TEXT NOT NULL DEFAULT '', station TEXT NOT NULL DEFAULT '',
+  from_kept INTEGER NOT NULL DEFAULT 0,
   PRIMARY KEY(order_id, part));
 CREATE TABLE IF NOT EXISTS commands(
   resource TEXT NOT NULL, command_id TEXT NOT NULL, order_id TEXT NOT NULL, operation TEXT NOT NULL,
@@ -171,8 +172,13 @@ CellStore::~CellStore() { sqlite3_close(db_); }
 
 // A database written before a column existed gets it, with its default.
 void CellStore::add_columns_of_later_versions() {
-  Statement columns(db_, "SELECT 1 FROM pragma_table_info('orders') WHERE name = 'quote'");
-  if (!columns.step()) exec("ALTER TABLE orders ADD COLUMN quote INTEGER NOT NULL DEFAULT 0");
+  const auto has = [this](const char* table, const char* column) {
+    Statement c(db_, "SELECT 1 FROM pragma_table_info(?) WHERE name = ?");
+    c.bind(table, column);
+    return c.step();
+  };
+  if (!has("orders", "quote")) exec("ALTER TABLE orders ADD COLUMN quote INTEGER NOT NULL DEFAULT 0");
+  if (!has("parts", "from_kept")) exec("ALTER TABLE parts ADD COLUMN from_kept INTEGER NOT NULL DEFAULT 0");
 }
 
 void CellStore::exec(const char* sql) const {
@@ -209,16 +215,20 @@ void CellStore::give(const std::string& buffer, const std::string& type, const s
   Statement take(db_, "UPDATE stock SET count = count - 1 WHERE buffer = ? AND part_type = ? AND count > 0");
   take.bind(buffer, type).step();
   if (sqlite3_changes(db_) != 1) throw StoreError("buffer " + buffer + " has no " + type + " in its stored stock");
-  // A part given back earlier may be handed out again under the same name.
-  Statement put(db_,
-                "INSERT INTO parts(order_id, part, part_type, buffer, place, holder) VALUES(?, ?, ?, ?, 'in_transit', ?) "
-                "ON CONFLICT(order_id, part) DO UPDATE SET part_type = excluded.part_type, buffer = excluded.buffer, "
-                "place = 'in_transit', holder = excluded.holder, station = '' WHERE place = 'returned'");
-  put.bind(order, part, type, buffer, carrier).step();
-  if (sqlite3_changes(db_) != 1) throw StoreError("part " + part + " of order " + order + " was handed out already");
   Statement(db_, "UPDATE kept SET count = count - 1 WHERE buffer = ? AND order_id = ? AND part_type = ? AND count > 0")
       .bind(buffer, order, type)
       .step();
+  // Whether the part was one the order kept: an undone give keeps it again, or not.
+  const int from_kept = sqlite3_changes(db_);
+  // A part given back earlier may be handed out again under the same name.
+  Statement put(db_,
+                "INSERT INTO parts(order_id, part, part_type, buffer, place, holder, from_kept) "
+                "VALUES(?, ?, ?, ?, 'in_transit', ?, ?) "
+                "ON CONFLICT(order_id, part) DO UPDATE SET part_type = excluded.part_type, buffer = excluded.buffer, "
+                "place = 'in_transit', holder = excluded.holder, station = '', from_kept = excluded.from_kept "
+                "WHERE place = 'returned'");
+  put.bind(order, part, type, buffer, carrier, from_kept).step();
+  if (sqlite3_changes(db_) != 1) throw StoreError("part " + part + " of order " + order + " was handed out already");
   t.commit();
 }
 
@@ -237,16 +247,21 @@ bool CellStore::given(const std::string& buffer, const std::string& order, const
 
 std::vector<PartRecord> CellStore::undo_unanswered_gives(const std::string& buffer) {
   Transaction t(*this);
-  Statement rows(db_, "SELECT p.order_id, p.part, p.part_type, p.holder FROM parts p JOIN commands c "
+  Statement rows(db_, "SELECT p.order_id, p.part, p.part_type, p.holder, p.from_kept FROM parts p JOIN commands c "
                       "ON c.resource = p.buffer AND c.order_id = p.order_id AND c.part = p.part AND c.operation = 'give' "
                       "WHERE p.buffer = ? AND p.place = 'in_transit' ORDER BY p.order_id, p.part");
   rows.bind(buffer);
   std::vector<PartRecord> undone;
-  while (rows.step()) undone.push_back({rows.text(0), rows.text(1), rows.text(2), buffer, rows.text(3), Place::in_transit, ""});
-  for (const auto& p : undone) {
-    put_back(p);
+  std::vector<bool> kept;
+  while (rows.step()) {
+    undone.push_back({rows.text(0), rows.text(1), rows.text(2), buffer, rows.text(3), Place::in_transit, ""});
+    kept.push_back(rows.integer(4) != 0);
+  }
+  for (std::size_t i = 0; i < undone.size(); ++i) {
+    put_back(undone[i]);
+    if (!kept[i]) continue;  // taken from the free stock: it goes back there
     Statement(db_, "UPDATE kept SET count = count + 1 WHERE buffer = ? AND order_id = ? AND part_type = ?")
-        .bind(buffer, p.order, p.part_type)
+        .bind(buffer, undone[i].order, undone[i].part_type)
         .step();
   }
   t.commit();

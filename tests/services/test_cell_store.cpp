@@ -162,6 +162,21 @@ TEST_CASE("a give counted out whose command was never answered goes back to the 
   require_conserved(store);
 }
 
+TEST_CASE("an undone give that took a part from the free stock keeps none for its order", "[state]") {
+  state::CellStore store(fresh_dir("unanswered-free"));
+  store.open_buffer("buffer-1", {{"Peg", 3}});
+  store.keep("buffer-1", "o1", "Peg", 1);
+  store.command_taken({"buffer-1", "o1/g1", "o1", "give", "o1/peg-1"});
+  store.give("buffer-1", "Peg", "o1", "o1/peg-1", "robot-1");  // the kept one
+  store.command_ended("buffer-1", "o1/g1");
+  store.command_taken({"buffer-1", "o1/g2", "o1", "give", "o1/peg-2"});
+  store.give("buffer-1", "Peg", "o1", "o1/peg-2", "robot-1");  // nothing kept left: a free one
+  REQUIRE(store.undo_unanswered_gives("buffer-1").size() == 1);
+  CHECK(store.inventory().at("Peg").in_buffers == 2);
+  CHECK(store.kept("buffer-1").count("o1") == 0);  // back in the free stock, not kept for o1
+  require_conserved(store);
+}
+
 TEST_CASE("bookings, orders and the journal", "[state]") {
   state::CellStore store(fresh_dir("holds"));
   store.set_bookings("station-1", {{"o1", {"o1/host"}, 40, true}, {"o2", {"o2/host", "o2/host-2"}, 30, false}});
