@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <sqlite3.h>
+
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <random>
@@ -175,6 +177,38 @@ TEST_CASE("an undone give that took a part from the free stock keeps none for it
   CHECK(store.inventory().at("Peg").in_buffers == 2);
   CHECK(store.kept("buffer-1").count("o1") == 0);  // back in the free stock, not kept for o1
   require_conserved(store);
+}
+
+TEST_CASE("a database of an earlier version gets the later columns and is used as it stands", "[state]") {
+  const fs::path dir = fresh_dir("earlier");
+  fs::create_directories(dir);
+  sqlite3* db = nullptr;
+  REQUIRE(sqlite3_open(state::CellStore::file_in(dir).c_str(), &db) == SQLITE_OK);
+  // The tables as 2026-11 wrote them: parts without from_kept, orders without quote.
+  REQUIRE(sqlite3_exec(db, R"sql(
+    CREATE TABLE parts(order_id TEXT NOT NULL, part TEXT NOT NULL, part_type TEXT NOT NULL, buffer TEXT NOT NULL,
+      place TEXT NOT NULL, holder TEXT NOT NULL DEFAULT '', station TEXT NOT NULL DEFAULT '', PRIMARY KEY(order_id, part));
+    CREATE TABLE orders(order_id TEXT PRIMARY KEY, state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '', updated REAL,
+      product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', sequence TEXT NOT NULL DEFAULT '',
+      path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0);
+    INSERT INTO parts VALUES('o0', 'o0/peg-1', 'Peg', 'buffer-1', 'assembled', '', 'station-1');
+  )sql", nullptr, nullptr, nullptr) == SQLITE_OK);
+  sqlite3_close(db);
+  state::CellStore store(dir);
+  store.open_buffer("buffer-1", {{"Peg", 3}});
+  store.keep("buffer-1", "o1", "Peg", 1);
+  store.command_taken({"buffer-1", "o1/g1", "o1", "give", "o1/peg-1"});
+  store.give("buffer-1", "Peg", "o1", "o1/peg-1", "robot-1");
+  REQUIRE(store.undo_unanswered_gives("buffer-1").size() == 1);
+  CHECK(store.kept("buffer-1").at("o1").at("Peg") == 1);
+  CHECK(store.inventory().at("Peg").assembled == 1);  // the earlier row stands
+  REQUIRE(sqlite3_open(state::CellStore::file_in(dir).c_str(), &db) == SQLITE_OK);
+  int columns = 0;
+  REQUIRE(sqlite3_exec(db, "SELECT name FROM pragma_table_info('parts') WHERE name = 'from_kept' UNION ALL "
+                           "SELECT name FROM pragma_table_info('orders') WHERE name = 'quote'",
+                       [](void* n, int, char**, char**) { return ++*static_cast<int*>(n), 0; }, &columns, nullptr) == SQLITE_OK);
+  sqlite3_close(db);
+  CHECK(columns == 2);
 }
 
 TEST_CASE("bookings, orders and the journal", "[state]") {
