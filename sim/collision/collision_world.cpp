@@ -1,5 +1,7 @@
 #include "sim/collision/collision_world.hpp"
 
+#include "sim/mesh/triangle_bvh.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -19,7 +21,7 @@ namespace {
 // Bullet works in millimetres here: its GJK/EPA are tuned for bodies of 0.1 to 10 units, and
 // in metres a 15 mm peg gave penetration depths that were plainly wrong. The API stays in
 // metres; only this file sees Bullet units.
-constexpr double kUnitsPerMetre = 1000.0;
+constexpr double kUnitsPerMetre = kBulletUnitsPerMetre;
 
 btVector3 to_bullet(const Eigen::Vector3d& v) {
   return btVector3(v.x() * kUnitsPerMetre, v.y() * kUnitsPerMetre, v.z() * kUnitsPerMetre);
@@ -177,11 +179,28 @@ void static_pieces(const btCollisionShape* shape, const btTransform& world, cons
   visit(static_cast<const btConvexShape*>(shape), world);
 }
 
+// A convex hull whose points are set anew for each piece: a concave part's swept pieces are
+// one per triangle, and a hull allocated for each was a tenth of a plan of a ring stack.
+class ReusableHull : public btConvexHullShape {
+ public:
+  void set(const btVector3* points, int count, btScalar margin) {
+    m_unscaledPoints.resize(count);
+    std::copy(points, points + count, &m_unscaledPoints[0]);
+    setMargin(margin);
+    recalcLocalAabb();
+  }
+};
+
 // A convex piece of a moving body, where it stands (world), and the member it belongs to.
+// The piece is `shape`, or (null) the hull of `count` corners from `first` on in the list that
+// comes with it, with that margin.
 struct MovingPiece {
   const btConvexShape* shape;
   btTransform at;
   const std::string* member;
+  std::size_t first = 0;
+  int count = 0;
+  btScalar margin = 0;
   // A piece that closes on its seat along `ahead` (world, unit): static pieces wholly beyond
   // `ends_at` along it are not asked.
   btVector3 ahead{0, 0, 0};
@@ -198,6 +217,15 @@ void cut_at_end(const MovingPiece& piece, btVector3& lo, btVector3& hi) {
   }
 }
 
+// How far along `axis` a box begins (its least extent).
+btScalar box_begins_at(const btVector3& lo, const btVector3& hi, const btVector3& axis) {
+  btScalar least = BT_LARGE_FLOAT;
+  for (int c = 0; c < 8; ++c) {
+    least = std::min(least, btVector3(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z()).dot(axis));
+  }
+  return least;
+}
+
 // How far along `axis` the static piece begins (its least extent, margin included).
 btScalar begins_at(const btConvexShape* piece, const btTransform& at, const btVector3& axis) {
   if (piece->getShapeType() == TRIANGLE_SHAPE_PROXYTYPE) {
@@ -208,11 +236,7 @@ btScalar begins_at(const btConvexShape* piece, const btTransform& at, const btVe
   }
   btVector3 lo, hi;
   piece->getAabb(at, lo, hi);
-  btScalar least = BT_LARGE_FLOAT;
-  for (int c = 0; c < 8; ++c) {
-    least = std::min(least, btVector3(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z()).dot(axis));
-  }
-  return least;
+  return box_begins_at(lo, hi, axis);
 }
 
 struct Overlapping : btBroadphaseAabbCallback {
@@ -355,10 +379,9 @@ struct CollisionWorld::Impl {
 
   struct SharedMesh {
     std::shared_ptr<const TriangleMesh> mesh;
-    std::vector<float> vertices;
-    std::vector<int> indices;
-    std::unique_ptr<btTriangleIndexVertexArray> array;
-    std::unique_ptr<btCollisionShape> shape;
+    btCollisionShape* shape = nullptr;              // one of the two below
+    std::unique_ptr<btCompoundShape> pieces;        // convex pieces
+    std::unique_ptr<StaticMeshShape> triangles;     // or a concave mesh's triangles
     std::unique_ptr<btCollisionShape> coarse;  // a concave mesh's hull, asked before its BVH
     std::vector<std::unique_ptr<btCollisionShape>> hulls;
   };
@@ -382,7 +405,7 @@ struct CollisionWorld::Impl {
   btCollisionShape* static_shape_for(std::shared_ptr<const TriangleMesh> mesh, double margin) {
     auto [it, inserted] = meshes.try_emplace(mesh.get());
     SharedMesh& shared = it->second;
-    if (!inserted) return shared.shape.get();
+    if (!inserted) return shared.shape;
     shared.mesh = mesh;
     if (pieces_are_exact(*mesh)) {
       auto compound = std::make_unique<btCompoundShape>(true, static_cast<int>(mesh->pieces.size()));
@@ -391,22 +414,12 @@ struct CollisionWorld::Impl {
         compound->addChildShape(btTransform::getIdentity(), hull.get());
         shared.hulls.push_back(std::move(hull));
       }
-      shared.shape = std::move(compound);
-      return shared.shape.get();
+      shared.pieces = std::move(compound);
+      return shared.shape = shared.pieces.get();
     }
-    for (const auto& v : mesh->vertices) {
-      const btVector3 b = to_bullet(v);
-      shared.vertices.insert(shared.vertices.end(), {float(b.x()), float(b.y()), float(b.z())});
-    }
-    for (const auto& t : mesh->triangles) shared.indices.insert(shared.indices.end(), {int(t[0]), int(t[1]), int(t[2])});
-    shared.array = std::make_unique<btTriangleIndexVertexArray>(
-        static_cast<int>(mesh->triangles.size()), shared.indices.data(), 3 * sizeof(int),
-        static_cast<int>(mesh->vertices.size()), shared.vertices.data(), 3 * sizeof(float));
-    auto bvh = std::make_unique<btBvhTriangleMeshShape>(shared.array.get(), true);
-    bvh->setMargin(margin * kUnitsPerMetre);
-    shared.shape = std::move(bvh);
+    shared.triangles = std::make_unique<StaticMeshShape>(*mesh, margin);
     shared.coarse = coarse_hull_of(*mesh, margin);
-    return shared.shape.get();
+    return shared.shape = &shared.triangles->shape();
   }
   btCollisionShape* coarse_shape_of(const TriangleMesh* mesh) const {
     const auto it = meshes.find(mesh);
@@ -445,9 +458,14 @@ struct CollisionWorld::Impl {
   // than the distances.
   std::optional<Clearance> nearest_of(const std::vector<MovingPiece>& pieces,
                                       const std::vector<const btCollisionObject*>& near, btScalar threshold,
-                                      const ClearanceFilter& counts) const {
+                                      const ClearanceFilter& counts, const std::vector<btVector3>& corners = {}) const {
     std::optional<Clearance> best;
-    for (const MovingPiece& piece : pieces) {
+    ReusableHull hull;
+    for (MovingPiece piece : pieces) {
+      if (!piece.shape) {
+        hull.set(&corners[piece.first], piece.count, piece.margin);
+        piece.shape = &hull;
+      }
       btVector3 box_lo, box_hi;
       piece.shape->getAabb(piece.at, box_lo, box_hi);
       for (const btCollisionObject* other : near) {
@@ -578,7 +596,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
   // Piece by piece: each convex child, and a concave member's triangles (its exact shape,
   // whose compound of 10k children took longer to build than the distances). Swept hulls
   // only for the pieces that come within reach of a near body's box.
-  std::vector<std::unique_ptr<btConvexHullShape>> hulls;
+  std::vector<btVector3> corners;  // of every swept piece, one after the other
   std::vector<MovingPiece> pieces;
   std::vector<btVector3> points;  // a piece's corners and the same shifted, in the body's frame
   std::vector<btVector3> in_world;
@@ -591,20 +609,22 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
       lo.setMin(in_world.back());
       hi.setMax(in_world.back());
     }
-    const btVector3 grown = pad + btVector3(margin, margin, margin);
-    const bool within_reach = std::any_of(near.objects.begin(), near.objects.end(), [&](const btCollisionObject* o) {
-      const btBroadphaseProxy* proxy = o->getBroadphaseHandle();
-      return TestAabbAgainstAabb2(lo - grown, hi + grown, proxy->m_aabbMin, proxy->m_aabbMax);
-    });
-    if (!within_reach) return;
-    hulls.push_back(hull_of_points(points, margin));
-    MovingPiece piece{hulls.back().get(), at, &member};
+    MovingPiece piece{nullptr, at, &member, corners.size(), static_cast<int>(points.size()), margin};
     if (member == closing && ahead.length2() > 0) {
       piece.ahead = ahead;
       piece.ends_at = -BT_LARGE_FLOAT;
       for (const btVector3& p : in_world) piece.ends_at = std::max(piece.ends_at, p.dot(ahead));
       piece.ends_at += margin;
     }
+    // Near a body's box, and not wholly short of it (nothing in it would be asked).
+    const btVector3 grown = pad + btVector3(margin, margin, margin);
+    const bool within_reach = std::any_of(near.objects.begin(), near.objects.end(), [&](const btCollisionObject* o) {
+      const btBroadphaseProxy* proxy = o->getBroadphaseHandle();
+      return TestAabbAgainstAabb2(lo - grown, hi + grown, proxy->m_aabbMin, proxy->m_aabbMax) &&
+             (piece.ends_at >= BT_LARGE_FLOAT || box_begins_at(proxy->m_aabbMin, proxy->m_aabbMax, ahead) <= piece.ends_at);
+    });
+    if (!within_reach) return;
+    corners.insert(corners.end(), points.begin(), points.end());
     pieces.push_back(piece);
   };
   for (int i = 0; i < coarse.getNumChildShapes(); ++i) {
@@ -625,7 +645,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
       consider(member, static_cast<btScalar>(moving.margin));
     }
   }
-  return impl_->nearest_of(pieces, near.objects, threshold, counts);
+  return impl_->nearest_of(pieces, near.objects, threshold, counts, corners);
 }
 
 namespace {

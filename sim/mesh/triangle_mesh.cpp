@@ -1,6 +1,7 @@
 #include "sim/mesh/triangle_mesh.hpp"
 
 #include "sim/mesh/mesh_disk_cache.hpp"
+#include "sim/mesh/triangle_bvh.hpp"
 
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
@@ -169,6 +170,7 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   mesh->convex = is_convex(*mesh);
   mesh->hull_corners = hull_corners(*mesh);
   make_coarse_hull(*mesh);
+  if (!pieces_are_exact(*mesh)) mesh->bvh_nodes = triangle_bvh_nodes(*mesh);
   return mesh;
 }
 

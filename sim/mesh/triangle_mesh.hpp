@@ -35,6 +35,10 @@ struct TriangleMesh {
   // One closed piece whose surface is its convex hull (a box, a pin): its hull is exact.
   // False for anything concave, open or inconsistently wound, which is the safe side.
   bool convex = false;
+  // A concave one-piece mesh's triangle tree, as Bullet checks a static one: its nodes, made
+  // at loading and kept in the disk cache (sim/mesh/triangle_bvh.hpp). Empty for other meshes,
+  // and for one made in code: the collision world then builds the tree.
+  std::vector<std::uint8_t> bvh_nodes;
 
   // What loading found and repaired (a CAD export is rarely clean). Degenerate triangles
   // (a repeated corner, or no area) and duplicates (the same three corners) are dropped;

@@ -1,6 +1,13 @@
+#include <unistd.h>
+
+#include <cstring>
+#include <limits>
+
 #include <catch2/catch.hpp>
 
 #include "sim/collision/collision_world.hpp"
+#include "sim/mesh/mesh_disk_cache.hpp"
+#include "sim/mesh/triangle_bvh.hpp"
 #include "tests/support/meshes.hpp"
 
 namespace {
@@ -221,4 +228,67 @@ TEST_CASE("clearance of a closing member leaves out what lies beyond the end of 
   REQUIRE(beside);
   CHECK(beside->body_name == "post");
   CHECK(beside->distance == Approx(0.0005).margin(1e-5));
+}
+
+TEST_CASE("a concave mesh's triangle tree is made at loading, kept by the disk cache, and used only where it is whole",
+          "[collision][mesh][cache]") {
+  const auto folder = std::filesystem::temp_directory_path() / ("bvh-cache-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(folder);
+  const auto file = std::filesystem::path(TEST_DATA_DIR) / "planning/shaft-bearing/meshes/bearing.obj";
+  const auto loaded = sim::MeshCache(folder).get(file, 1e-3);
+  REQUIRE_FALSE(sim::pieces_are_exact(*loaded));
+  const std::size_t node_size = 16, nodes = 2 * loaded->triangles.size() - 1;  // a leaf per triangle
+  CHECK(loaded->bvh_nodes.size() == nodes * node_size);
+  const auto cached = sim::MeshDiskCache(folder).load(file, 1e-3);
+  CHECK(cached->bvh_nodes == loaded->bvh_nodes);
+  const double margin = sim::CollisionOptions{}.shape_margin;
+  CHECK(sim::StaticMeshShape(*cached, margin).tree_was_kept());
+  std::filesystem::remove_all(folder);
+
+  // A damaged tree (a leaf naming a triangle the mesh does not have, a skip out of the tree,
+  // nodes missing) is built anew; so is none.
+  const auto leaf = [&](bool want_leaf) {
+    for (std::size_t i = 0; i < nodes; ++i) {
+      std::int32_t v = 0;
+      std::memcpy(&v, loaded->bvh_nodes.data() + i * node_size + 12, sizeof v);
+      if ((v >= 0) == want_leaf) return i;
+    }
+    return nodes;
+  };
+  const auto with_node = [&](std::size_t at, std::int32_t value) {
+    auto m = std::make_shared<sim::TriangleMesh>(*loaded);
+    std::memcpy(m->bvh_nodes.data() + at * node_size + 12, &value, sizeof value);
+    return m;
+  };
+  CHECK_FALSE(sim::StaticMeshShape(*with_node(leaf(true), static_cast<std::int32_t>(loaded->triangles.size())), margin)
+                  .tree_was_kept());
+  CHECK_FALSE(sim::StaticMeshShape(*with_node(leaf(false), -static_cast<std::int32_t>(nodes) - 1), margin).tree_was_kept());
+  CHECK_FALSE(sim::StaticMeshShape(*with_node(leaf(false), std::numeric_limits<std::int32_t>::min()), margin).tree_was_kept());
+  auto none = std::make_shared<sim::TriangleMesh>(*loaded);
+  none->bvh_nodes.resize(node_size * (nodes - 1));
+  CHECK_FALSE(sim::StaticMeshShape(*none, margin).tree_was_kept());
+  none->bvh_nodes.clear();
+  CHECK_FALSE(sim::StaticMeshShape(*none, margin).tree_was_kept());
+
+  // The kept tree answers as one built anew: a 2 mm cube probed around and through the bearing.
+  sim::CollisionWorld kept_world, built_world;
+  kept_world.add_static_mesh("bearing", loaded, sim::Pose::Identity());
+  built_world.add_static_mesh("bearing", none, sim::Pose::Identity());
+  const auto cube = box_body({0.001, 0.001, 0.001}, kept_world);
+  const Eigen::AlignedBox3d box = loaded->bounds;
+  int hits = 0, misses = 0;
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 8; ++j) {
+      for (int k = 0; k <= 8; ++k) {
+        const Eigen::Vector3d p = box.min() + (box.max() - box.min()).cwiseProduct(Eigen::Vector3d(i, j, k) / 8.0);
+        const auto kept = kept_world.penetration(cube, at(p.x(), p.y(), p.z()));
+        const auto built = built_world.penetration(cube, at(p.x(), p.y(), p.z()));
+        REQUIRE(kept.has_value() == built.has_value());
+        if (kept) CHECK(kept->depth == Approx(built->depth).margin(1e-9));
+        ++(kept ? hits : misses);
+      }
+    }
+  }
+  CHECK(hits > 50);
+  CHECK(misses > 50);
 }

@@ -123,6 +123,7 @@ TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores
     CHECK(m.triangles == loaded->triangles);
     CHECK(m.pieces == loaded->pieces);
     CHECK(m.hull_corners == loaded->hull_corners);
+    CHECK(m.bvh_nodes == loaded->bvh_nodes);
     CHECK(m.bounds.isApprox(loaded->bounds));
     CHECK(m.convex == loaded->convex);
     CHECK(m.repairs.describe() == loaded->repairs.describe());
