@@ -15,6 +15,7 @@
 #include <set>
 
 #include <assimp/Importer.hpp>
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -150,6 +151,10 @@ std::string TriangleMesh::Repairs::describe() const {
 
 std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file, double scale) {
   Assimp::Importer importer;
+  // A COLLADA file's <unit> is applied (it is the file's own statement of its unit); its
+  // <up_axis> is not: a mesh is in its part's frame, whose coordinates the product's links
+  // use as the CAD system wrote them.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const aiScene* scene = importer.ReadFile(
       file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
   if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {

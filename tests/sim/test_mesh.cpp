@@ -153,3 +153,15 @@ TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores
   same(*sim::MeshDiskCache(folder).load(file, 1e-3));
   std::filesystem::remove_all(folder);
 }
+
+TEST_CASE("COLLADA: the file's own unit is applied, its up axis is not (coordinates as written)", "[mesh][units]") {
+  // A 20 mm cube from 0 to 20 mm on each axis, <unit meter="0.001">, declared Y up and Z up.
+  for (const char* file : {"planning/collada/meshes/block_mm_y_up.dae", "planning/collada/meshes/block_mm_z_up.dae"}) {
+    INFO(file);
+    const auto block = sim::load_mesh(data(file));
+    CHECK(block->triangles.size() == 12);
+    CHECK(block->bounds.min().isApprox(Eigen::Vector3d::Zero(), 1e-9));
+    CHECK(block->bounds.max().isApprox(Eigen::Vector3d(0.02, 0.02, 0.02), 1e-6));
+    CHECK(block->convex);
+  }
+}

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "tests/twin/test_support.hpp"
+#include "twin/description/automationml/automationml_description.hpp"
 #include "twin/description/automationml/precedence_writer.hpp"
 #include "twin/planning/assembly_planner.hpp"
 #include "twin/planning/precedence_suggestions.hpp"
@@ -196,6 +197,21 @@ TEST_CASE("a mesh in millimetres (LengthUnit mm) is placed and planned in metres
   CHECK(block.mesh->scale == 1e-3);
   CHECK(loaded.meshes[*loaded.product.find_part_by_name("block")]->bounds.sizes().y() == Approx(0.02));
   CHECK(test::position_mm(loaded.product, "block").y() == Approx(10));  // on the 10 mm plate
+}
+
+TEST_CASE("a COLLADA mesh states its own unit: it is placed as written, and a LengthUnit on it is an error",
+          "[planning][units]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan p = plan(test::data("planning/collada/collada.aml"), "search", cache, loaded);
+  REQUIRE(p.complete);
+  const auto& mesh = *loaded.meshes[*loaded.product.find_part_by_name("block")];
+  CHECK(mesh.bounds.min().isApprox(Eigen::Vector3d::Zero(), 1e-9));  // neither scaled twice nor turned to Y up
+  CHECK(mesh.bounds.max().isApprox(Eigen::Vector3d(0.02, 0.02, 0.02), 1e-6));
+  CHECK(test::position_mm(loaded.product, "block").y() == Approx(10));  // on the 10 mm plate
+  CHECK_THROWS_WITH(twin::AutomationMLDescription(test::data("planning/collada/collada_length_unit.aml")),
+                    Catch::Contains("collada_length_unit.aml:24") &&
+                        Catch::Contains("LengthUnit does not apply to the COLLADA mesh 'meshes/block_mm_z_up.dae'"));
 }
 
 TEST_CASE("insertion margins: the room each part and its gripper have on the way in, seats left out",

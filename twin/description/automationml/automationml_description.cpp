@@ -309,12 +309,24 @@ class CaexReader {
         if (!is_geometry_interface(i, uri)) continue;
         MeshRef mesh = resolve_mesh(uri, file_.where(uri_attribute));
         if (unit_attribute) {
+          if (is_collada(mesh.file)) {
+            // Its <asset><unit> is applied when it is read: a LengthUnit would scale it twice.
+            throw DescriptionError(file_.where(unit_attribute),
+                                   "LengthUnit does not apply to the COLLADA mesh '" + uri +
+                                       "': a .dae file states its own unit (<asset><unit meter=...>), which is used");
+          }
           mesh.scale = aml::length_unit_scale(aml::attribute_text(unit_attribute).value_or(""), file_.where(unit_attribute));
         }
         return mesh;
       }
     }
     return std::nullopt;
+  }
+
+  static bool is_collada(const std::filesystem::path& file) {
+    std::string extension = file.extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return extension == ".dae";
   }
 
   MeshRef resolve_mesh(std::string uri, const SourceRef& where) const {
