@@ -4,7 +4,10 @@
 //   build/release/tests/bench_planning
 // Figures and the command are recorded in docs/performance.md.
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <fstream>
 #include <sstream>
 
@@ -67,36 +70,59 @@ void BM_Tower(benchmark::State& state, const std::string& sequence) {
   std::filesystem::remove_all(file.parent_path());
 }
 
-// Twenty rings stacked, each its own one-piece concave mesh (a tube: 40 mm across, a 20 mm
-// bore, 5 mm tall) of about `triangles` triangles: OBJ files as a CAD export writes them.
-std::filesystem::path ring_stack(int triangles) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("bench-rings-" + std::to_string(::getpid()) + "-" + std::to_string(triangles));
+// `rings` rings stacked, each its own one-piece concave mesh (a tube: 40 mm across, a 20 mm
+// bore, 5 mm tall) of about `triangles` triangles: OBJ files in metres, or (`stl`) binary STL
+// files in millimetres with every corner repeated per triangle, as CAD exports write them.
+std::filesystem::path ring_stack(int triangles, int rings, bool stl) {
+  const auto dir = std::filesystem::temp_directory_path() / ("bench-rings-" + std::to_string(::getpid()) + "-" +
+                                                             std::to_string(triangles) + (stl ? "-stl" : ""));
   std::filesystem::create_directories(dir);
   const int segments = std::max(8, triangles / 8);
   std::ostringstream aml;
   aml << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<CAEXFile SchemaVersion=\"3.0\" FileName=\"rings.aml\" "
          "xmlns=\"http://www.dke.de/CAEX\"><InstanceHierarchy Name=\"Order\"><InternalElement Name=\"Rings\" ID=\"rings\">\n";
   std::ostringstream classes;
-  for (int r = 0; r < 20; ++r) {
+  for (int r = 0; r < rings; ++r) {
     const std::string name = "ring" + std::to_string(r);
-    std::ofstream obj(dir / (name + ".obj"));
-    obj << "o " << name << "\n";
     const double outer = 0.020 + r * 1e-5, inner = 0.010;  // each file its own content
+    std::vector<Eigen::Vector3d> v;
     for (const double y : {0.0, 0.005}) {
       for (int k = 0; k < segments; ++k) {
         const double t = 2 * M_PI * k / segments;
-        obj << "v " << outer * std::cos(t) << ' ' << y << ' ' << outer * std::sin(t) << "\nv " << inner * std::cos(t)
-            << ' ' << y << ' ' << inner * std::sin(t) << '\n';
+        v.emplace_back(outer * std::cos(t), y, outer * std::sin(t));
+        v.emplace_back(inner * std::cos(t), y, inner * std::sin(t));
       }
     }
-    const auto o = [&](int level, int k) { return level * 2 * segments + 2 * (k % segments) + 1; };
+    const auto o = [&](int level, int k) { return level * 2 * segments + 2 * (k % segments); };  // 0-based
+    std::vector<std::array<int, 3>> faces;
     for (int k = 0; k < segments; ++k) {
       const int a = o(0, k), b = o(0, k + 1), c = o(1, k + 1), d = o(1, k);
-      obj << "f " << a << ' ' << c << ' ' << b << "\nf " << a << ' ' << d << ' ' << c << '\n';              // outside
-      obj << "f " << a + 1 << ' ' << b + 1 << ' ' << c + 1 << "\nf " << a + 1 << ' ' << c + 1 << ' ' << d + 1 << '\n';  // bore
-      obj << "f " << d << ' ' << c + 1 << ' ' << c << "\nf " << d << ' ' << d + 1 << ' ' << c + 1 << '\n';  // top
-      obj << "f " << a << ' ' << b << ' ' << b + 1 << "\nf " << a << ' ' << b + 1 << ' ' << a + 1 << '\n';  // bottom
+      faces.insert(faces.end(), {{a, c, b}, {a, d, c}});                  // outside
+      faces.insert(faces.end(), {{a + 1, b + 1, c + 1}, {a + 1, c + 1, d + 1}});  // bore
+      faces.insert(faces.end(), {{d, c + 1, c}, {d, d + 1, c + 1}});      // top
+      faces.insert(faces.end(), {{a, b, b + 1}, {a, b + 1, a + 1}});      // bottom
+    }
+    const std::string mesh = name + (stl ? ".stl" : ".obj");
+    if (stl) {
+      std::ofstream out(dir / mesh, std::ios::binary);
+      const std::string header(80, ' ');
+      out.write(header.data(), 80);
+      const auto count = static_cast<std::uint32_t>(faces.size());
+      out.write(reinterpret_cast<const char*>(&count), 4);
+      for (const auto& f : faces) {
+        float numbers[12] = {0, 0, 0};
+        for (int c = 0; c < 3; ++c) {
+          for (int k = 0; k < 3; ++k) numbers[3 + 3 * c + k] = static_cast<float>(v[f[c]][k] * 1000);
+        }
+        const std::uint16_t attributes = 0;
+        out.write(reinterpret_cast<const char*>(numbers), sizeof numbers);
+        out.write(reinterpret_cast<const char*>(&attributes), 2);
+      }
+    } else {
+      std::ofstream obj(dir / mesh);
+      obj << "o " << name << "\n";
+      for (const auto& p : v) obj << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+      for (const auto& f : faces) obj << "f " << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
     }
     aml << "<InternalElement Name=\"" << name << "\" ID=\"" << name << "\" RefBaseSystemUnitPath=\"Lib/R" << r << "\"/>\n";
     if (r > 0) {
@@ -109,8 +135,9 @@ std::filesystem::path ring_stack(int triangles) {
             << "<Attribute Name=\"top\" Unit=\"mm\"><DefaultValue>0,5,0</DefaultValue></Attribute>"
             << "<ExternalInterface Name=\"top\" ID=\"R" << r << "-top\"/>"
             << "<ExternalInterface Name=\"geometry\" ID=\"R" << r << "-geometry\" RefBaseClassPath=\"ExternalDataReference\">"
-            << "<Attribute Name=\"refURI\"><Value>" << name << ".obj</Value></Attribute></ExternalInterface>"
-            << "</SystemUnitClass>\n";
+            << "<Attribute Name=\"refURI\"><Value>" << mesh << "</Value></Attribute>"
+            << (stl ? "<Attribute Name=\"LengthUnit\"><Value>mm</Value></Attribute>" : "")
+            << "</ExternalInterface></SystemUnitClass>\n";
   }
   aml << "</InternalElement></InstanceHierarchy><SystemUnitClassLib Name=\"Lib\">" << classes.str()
       << "</SystemUnitClassLib></CAEXFile>\n";
@@ -120,8 +147,9 @@ std::filesystem::path ring_stack(int triangles) {
 
 // What a twin pays for the ring stack: loading (every file parsed, or read back from the
 // disk cache that an earlier order filled) and planning.
-void BM_RingStack(benchmark::State& state, bool cached) {
-  const auto file = ring_stack(static_cast<int>(state.range(0)));
+// `state.range(1)` rings; `stl`: unwelded binary STL in millimetres.
+void BM_RingStack(benchmark::State& state, bool cached, bool stl = false) {
+  const auto file = ring_stack(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), stl);
   const auto disk = file.parent_path() / "cache";
   if (cached) {
     sim::MeshCache earlier_order(disk);
@@ -177,9 +205,12 @@ BENCHMARK_CAPTURE(BM_Wall, search_no_margins, std::string("search, no margins"))
 BENCHMARK_CAPTURE(BM_Tower, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Tower, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PegSweep)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_RingStack, first, false)->Arg(1000)->Arg(10000)->Arg(50000)->Arg(100000)->Iterations(1)
+BENCHMARK_CAPTURE(BM_RingStack, first, false)->Args({1000, 20})->Args({10000, 20})->Args({50000, 20})->Args({100000, 20})->Iterations(1)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_RingStack, cached, true)->Arg(1000)->Arg(10000)->Arg(50000)->Arg(100000)->Iterations(1)
+BENCHMARK_CAPTURE(BM_RingStack, cached, true)->Args({1000, 20})->Args({10000, 20})->Args({50000, 20})->Args({100000, 20})->Iterations(1)
     ->Unit(benchmark::kMillisecond);
+// A CAD export of 200k triangles per part: three rings as unwelded binary STL in millimetres.
+BENCHMARK_CAPTURE(BM_RingStack, stl_first, false, true)->Args({200000, 3})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_RingStack, stl_cached, true, true)->Args({200000, 3})->Iterations(1)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -94,6 +94,15 @@ TEST_CASE("a careless export: degenerate and duplicate triangles are dropped, op
   CHECK_FALSE(sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3)->repairs.any());
 }
 
+TEST_CASE("an edge shared by more than two triangles is counted and said", "[mesh][repairs]") {
+  const auto fins = sim::load_mesh(data("planning/messy/meshes/fins_mm.obj"), 1e-3);
+  CHECK(fins->triangles.size() == 3);
+  CHECK(fins->repairs.non_manifold_edges == 1);
+  CHECK(fins->repairs.open_edges == 6);
+  CHECK_FALSE(fins->convex);
+  CHECK_THAT(fins->repairs.describe(), Catch::Contains("1 edge shared by more than two triangles"));
+}
+
 TEST_CASE("flipped normals: triangles wound against their neighbours, or a piece inside out, are turned and said",
           "[mesh][repairs]") {
   const auto volume = [](const sim::TriangleMesh& m) {
