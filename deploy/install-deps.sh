@@ -9,6 +9,7 @@ packages=(
   libassimp-dev libtinygltf-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libyaml-cpp-dev
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
   libbenchmark-dev libsqlite3-dev sqlite3 libcgal-dev
+  libfcl-dev     # only for bench_collision_libraries: our collision check against FCL's
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
   chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
