@@ -20,7 +20,8 @@ using fb::get;
 class Outbox : public fb::FunctionBlock {
  public:
   Outbox() : FunctionBlock("outbox") {
-    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "QUOTE", "FINISHED", "CFP", "AWARD"}) {
+    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "QUOTE", "FINISHED", "CFP", "AWARD",
+                          "PLACED"}) {
       declare_input(e);
     }
   }
@@ -37,7 +38,7 @@ struct Twin {
     negotiation.quote_patience = std::chrono::milliseconds(0);  // a refused call for quotes ends at the next TICK
     orchestrator = &twin::add_order_network(resource, product, plan, order, negotiation);
     outbox = &resource.add(std::make_unique<Outbox>());
-    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "QUOTE", "FINISHED"}) {
+    for (const char* e : {"RELEASE", "COMMAND", "CANCEL", "SIM", "STATUS", "FINDING", "QUOTE", "FINISHED", "PLACED"}) {
       resource.connect("orchestrator", e, "outbox", e);
     }
     for (const char* e : {"CFP", "AWARD"}) resource.connect("negotiator", e, "outbox", e);
@@ -163,6 +164,8 @@ Outcome run(Twin& t, const Cell& cell) {
     } else if (e.name == "STATUS") {
       out.statuses.push_back(get<std::string>(e.data, "message"));
       queued_reported |= out.statuses.back().find("orders ahead") != std::string::npos;
+    } else if (e.name == "PLACED") {
+      out.order.push_back("PLACED");
     } else if (e.name == "FINDING") {
       out.findings.push_back(get<std::string>(e.data, "kind"));
     } else if (e.name == "FINISHED") {
@@ -199,6 +202,14 @@ TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holdin
   // The hired robot gets one fetch per part, the arm one grip per part.
   CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND fetch") == static_cast<long>(cranfield.plan.steps.size()));
   CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND grip") == static_cast<long>(cranfield.plan.steps.size()));
+  // A part is recorded in place as soon as the arm has let it go at its final pose, before
+  // the gripper backs out: a twin that dies then leaves it standing for the next one.
+  CHECK(std::count(out.order.begin(), out.order.end(), "PLACED") == static_cast<long>(cranfield.plan.steps.size()));
+  for (auto at = std::find(out.order.begin(), out.order.end(), "COMMAND release"); at != out.order.end();
+       at = std::find(at + 1, out.order.end(), "COMMAND release")) {
+    REQUIRE(at + 1 != out.order.end());
+    CHECK(*(at + 1) == "PLACED");
+  }
   // Virtual and physical assembly hold each part by the planned grasp: the gripper's four
   // bodies in cell-sim, the arm's grip as wide and turned as the plan's.
   for (const char* body : {"o1/virtual/gripper-palm", "o1/virtual/gripper-finger-1", "o1/virtual/gripper-finger-2",

@@ -742,7 +742,10 @@ void OrderOrchestrator::next_action() {
 
 void OrderOrchestrator::action_done() {
   const Action& a = actions_.front();
-  if (state() == "PHYSICAL" && a.kind == Action::command && get<std::string>(a.data, "operation") == "connect") {
+  // Released, the part stands in the product: the durable state says so at once. Recorded
+  // only at the connect after the gripper backed out, a twin that died in between left the
+  // part "at the dock" for the next one, which inserted it again.
+  if (state() == "PHYSICAL" && a.kind == Action::command && get<std::string>(a.data, "operation") == "release") {
     emit("PLACED", {{"part", get<std::string>(a.data, "part")}});
     const std::size_t left = std::count_if(actions_.begin(), actions_.end(), [](const Action& x) {
       return x.kind == Action::await_delivery;
