@@ -2,7 +2,11 @@
 // answered with command events, an empty buffer refusing, and its capability gone when it
 // stops. Bounded waits only; the process is always ended.
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <condition_variable>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 
@@ -11,6 +15,8 @@
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
+#include "services/node/restart_reason.hpp"
+#include "services/state/cell_store.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/hire.hpp"
 
@@ -153,4 +159,44 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
   CHECK(seen.gone.front() == "buffer-2");
   CHECK(noticed_after < 5.0);  // bound, not a speed target: the lease is 0.5 s
   test::clean_stale_dds_segments();  // what the killed process left behind
+}
+
+TEST_CASE("a buffer that restarts answers the command its process had taken on ABORTED, saying it restarted",
+          "[process][buffer][state]") {
+  constexpr int domain = 183;
+  test::clean_stale_dds_segments();
+  const auto dir = std::filesystem::temp_directory_path() / ("restarted-buffer-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  {  // What the process before it left: its stock, and a give taken on, never answered.
+    state::CellStore store(dir);
+    store.open_buffer("buffer-1", {{"SquarePeg", 2}});
+    store.command_taken({"buffer-1", "o1/give-1", "o1", "give", ""});
+  }
+  Seen seen;
+  auto participant = dds::make_participant("test-twin", {domain, true, {}});
+  dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
+      participant, "cell/command_events", dds::TopicKind::events,
+      [&](const cell::CommandEvent& e) { seen.add([&] { seen.events.push_back(e); }); });
+  const auto capabilities = watch_capabilities(participant, seen);
+  test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-1", "--domain", std::to_string(domain), "--stock",
+                             "SquarePeg=2", "--lease", "0.5", "--state-dir", dir.string()});
+  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+  // Its sender, which heard nothing, sends it again: the answer is the restart, not a give.
+  dds::Writer<cell::Command, cell::CommandPubSubType> commands(participant, dds::command_topic("buffer-1"),
+                                                               dds::TopicKind::events);
+  REQUIRE(commands.wait_for_readers(1, std::chrono::seconds(10)));
+  REQUIRE(commands.write(give("o1/give-1", "o1/peg-1", "o1/give/buffer-1")));
+  const auto answered = [&] {
+    return std::any_of(seen.events.begin(), seen.events.end(),
+                       [](const cell::CommandEvent& e) { return e.command_id() == "o1/give-1"; });
+  };
+  REQUIRE(seen.wait(answered));
+  for (const auto& e : seen.events) {
+    if (e.command_id() != "o1/give-1") continue;
+    CHECK(e.state() == cell::ABORTED);
+    CHECK(e.reason() == fb::restarted_reason("buffer-1"));
+  }
+  CHECK(stock_of(seen.capabilities.back(), "SquarePeg") == 2);  // nothing given
+  CHECK(buffer.stop() == 0);
+  std::filesystem::remove_all(dir);
 }
