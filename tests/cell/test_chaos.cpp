@@ -1,6 +1,8 @@
 // The chaos test, short (the full one is bench_chaos): orders on a cell with two stations
 // and two robots while a killer SIGKILLs its processes, cellctl up once among them.
 
+#include <algorithm>
+
 #include <catch2/catch.hpp>
 
 #include "tests/support/chaos.hpp"
@@ -13,6 +15,7 @@ TEST_CASE("chaos: kills of any process lose no part, leave no hold and no proces
   o.domain = 196;
   o.orders = 4;
   o.kills = 6;
+  o.first_victims = {"twin", "cell-sim"};  // besides the random picks and cellctl up
   o.order_timeout = std::chrono::seconds(150);
   const test::ChaosResult r = test::run_chaos(o);
 
@@ -21,6 +24,12 @@ TEST_CASE("chaos: kills of any process lose no part, leave no hold and no proces
   for (const auto& f : r.failures) failures += f + "\n";
   INFO("kills:\n" << kills << "failures:\n" << failures);
   CHECK(r.kills.size() == 6);
+  const auto killed = [&](const std::string& what) {
+    return std::any_of(r.kills.begin(), r.kills.end(), [&](const std::string& k) { return k.find(what) != std::string::npos; });
+  };
+  CHECK(killed(" order-"));  // a twin with its order
+  CHECK(killed(" cell-sim "));
+  CHECK(killed(" cellctl up "));
   CHECK(r.unfinished == 0);
   CHECK(r.assembled + r.failed == 4);
   for (const auto& f : r.failures) CHECK(f.size() > std::string("order-1: ").size() + 10);  // a stated reason

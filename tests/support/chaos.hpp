@@ -38,6 +38,9 @@ struct ChaosOptions {
   int orders = 10, kills = 20;
   std::string real_time_factor = "10";
   unsigned seed = 1;
+  // Killed first, where they run, before the random picks: process names ("twin": one that
+  // has its order). A short run's random picks may miss a kind the test means to kill.
+  std::vector<std::string> first_victims;
   std::chrono::seconds order_timeout{600};  // for all orders to end after the last kill
   std::function<void(const std::string&)> log = [](const std::string&) {};
 };
@@ -143,6 +146,7 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
 
   state::CellStore store(state_dir);
   std::mt19937 random(o.seed);
+  std::vector<std::string> first_victims = o.first_victims;
   const auto next_gap = [&] { return std::chrono::milliseconds(2000 + random() % 3001); };
   Clock::time_point next_kill = Clock::now() + next_gap();
   struct Pending {
@@ -218,7 +222,19 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
         while (any_left() && Clock::now() < deadline) std::this_thread::sleep_for(50ms);
         up = start_up();
       } else if (const auto children = children_of(up->pid()); !children.empty()) {
-        const auto& [name, pid] = children[random() % children.size()];
+        std::size_t pick = children.size();
+        for (auto kind = first_victims.begin(); kind != first_victims.end() && pick == children.size(); ++kind) {
+          for (std::size_t i = 0; i < children.size(); ++i) {
+            const auto& [name, pid] = children[i];
+            if (name == *kind && (name != "twin" || chaos_detail::identity_of(pid, name, store) != name)) {
+              pick = i;
+              first_victims.erase(kind);
+              break;
+            }
+          }
+        }
+        if (pick == children.size()) pick = random() % children.size();
+        const auto& [name, pid] = children[pick];
         const std::string identity = chaos_detail::identity_of(pid, name, store);
         ::kill(pid, SIGKILL);
         r.kills.push_back("t=" + std::to_string(seconds()) + " " + identity + " (pid " + std::to_string(pid) + ")");
