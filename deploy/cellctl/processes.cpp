@@ -11,7 +11,11 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <string>
 #include <thread>
+#include <vector>
+
+#include "services/node/started_by.hpp"
 
 extern char** environ;
 
@@ -46,7 +50,17 @@ Process::Process(std::string name, const std::vector<std::string>& argv, const s
   for (const auto& [fd, file] : {std::pair{STDOUT_FILENO, &stdout_to}, std::pair{STDERR_FILENO, &stderr_to}}) {
     if (!file->empty()) posix_spawn_file_actions_addopen(&actions, fd, file->c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   }
-  const int spawned = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+  // The child's environment: ours, and who started it (services::stop_with_parent).
+  std::vector<std::string> variables;
+  const std::string parent = std::string(services::kStartedByVariable) + "=";
+  for (char** v = environ; *v; ++v) {
+    if (std::string(*v).rfind(parent, 0) != 0) variables.emplace_back(*v);
+  }
+  variables.push_back(parent + std::to_string(::getpid()));
+  std::vector<char*> environment;
+  for (auto& v : variables) environment.push_back(v.data());
+  environment.push_back(nullptr);
+  const int spawned = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environment.data());
   posix_spawn_file_actions_destroy(&actions);
   if (with_input) {
     ::close(input[1]);

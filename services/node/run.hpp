@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <sys/prctl.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <csignal>
@@ -12,13 +13,18 @@
 #include <thread>
 #include <vector>
 
+#include "services/node/started_by.hpp"
 #include "services/runtime/resource.hpp"
 
 namespace services {
 
 // The process gets SIGTERM when the process that started it ends, however it ends: a cell or
-// a twin never outlives the cellctl (or test) that started it.
-inline void stop_with_parent() { ::prctl(PR_SET_PDEATHSIG, SIGTERM); }
+// a twin never outlives the cellctl (or test) that started it. One whose starter ended before
+// this call (it would never get the signal) gets it at once, where the starter said its pid.
+inline void stop_with_parent() {
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (const char* parent = std::getenv(kStartedByVariable); parent && std::atol(parent) != ::getppid()) std::raise(SIGTERM);
+}
 
 // Armed when it goes out of scope: ends the process with `code` if it still runs `limit`
 // later. Declared after a process's DDS entities, it is destroyed before them: their teardown

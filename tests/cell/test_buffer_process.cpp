@@ -17,6 +17,7 @@
 #include "services/dds/endpoints.hpp"
 #include "services/node/restart_reason.hpp"
 #include "services/state/cell_store.hpp"
+#include "tests/support/cell_test.hpp"
 #include "tests/support/child_process.hpp"
 #include "tests/support/hire.hpp"
 
@@ -199,4 +200,24 @@ TEST_CASE("a buffer that restarts answers the command its process had taken on A
   CHECK(stock_of(seen.capabilities.back(), "SquarePeg") == 2);  // nothing given
   CHECK(buffer.stop() == 0);
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("a cell process whose starter ended before it could ask to end with it ends at once", "[process][buffer]") {
+  test::clean_stale_dds_segments();
+  const auto log = std::filesystem::temp_directory_path() / ("started-by-" + std::to_string(::getpid()) + ".log");
+  const auto start = [&](pid_t starter) {  // through env(1), which runs the buffer in its own process
+    return test::ChildProcess({"/usr/bin/env", "AGILE_CELL_STARTED_BY=" + std::to_string(starter), BUFFER_EXE, "--id",
+                               "buffer-1", "--domain", "184"},
+                              log.string());
+  };
+  {  // Started by this test, which runs: it stays.
+    test::ChildProcess buffer = start(::getpid());
+    CHECK(test::appears(log, "ready on domain", std::chrono::seconds(20)));
+    CHECK(buffer.stop() == 0);
+  }
+  {  // Its starter (pid 1 stands for one that is gone; the buffer's parent is this test) ended.
+    test::ChildProcess orphan = start(1);
+    CHECK(orphan.wait_for_exit(std::chrono::seconds(20)) == 0);
+  }
+  std::filesystem::remove(log);
 }
