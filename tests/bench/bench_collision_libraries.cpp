@@ -89,15 +89,22 @@ Case from(const benchmark::State& state) {
   }
 }
 
+// The case as the cell checks it: the static ring in a world, what moves a body.
+struct BulletCase {
+  explicit BulletCase(const Case& c) {
+    world.add_static_mesh("base", c.base, sim::Pose::Identity());
+    body.add_mesh("part", c.moving, sim::Pose::Identity(), world.options().shape_margin);
+  }
+  sim::CollisionWorld world;
+  sim::MovingBody body;
+};
+
 void BM_Bullet(benchmark::State& state) {
   const Case c = from(state);
-  sim::CollisionWorld world;
-  world.add_static_mesh("base", c.base, sim::Pose::Identity());
-  sim::MovingBody body;
-  body.add_mesh("part", c.moving, sim::Pose::Identity(), world.options().shape_margin);
+  BulletCase bullet(c);
   std::optional<sim::Contact> hit;
   for (auto _ : state) {
-    hit = world.penetration(body, c.pose);
+    hit = bullet.world.penetration(bullet.body, c.pose);
     benchmark::DoNotOptimize(hit);
   }
   state.counters["collides"] = hit ? 1 : 0;
@@ -139,13 +146,10 @@ void BM_Fcl(benchmark::State& state) {
 // The ring held 1 mm above the other: the nearest distance within 10 mm.
 void BM_Bullet_distance(benchmark::State& state) {
   const Case c = make_case(static_cast<int>(state.range(0)), 0, kHeight + 0.001);
-  sim::CollisionWorld world;
-  world.add_static_mesh("base", c.base, sim::Pose::Identity());
-  sim::MovingBody body;
-  body.add_mesh("part", c.moving, sim::Pose::Identity(), world.options().shape_margin);
+  BulletCase bullet(c);
   std::optional<sim::Clearance> nearest;
   for (auto _ : state) {
-    nearest = world.nearest(body, c.pose, 0.010);
+    nearest = bullet.world.nearest(bullet.body, c.pose, 0.010);
     benchmark::DoNotOptimize(nearest);
   }
   state.counters["distance_mm"] = nearest ? nearest->distance * 1000 : -1;
