@@ -178,7 +178,11 @@ void CellStore::add_columns_of_later_versions() {
     return c.step();
   };
   if (!has("orders", "quote")) exec("ALTER TABLE orders ADD COLUMN quote INTEGER NOT NULL DEFAULT 0");
-  if (!has("parts", "from_kept")) exec("ALTER TABLE parts ADD COLUMN from_kept INTEGER NOT NULL DEFAULT 0");
+  if (!has("parts", "from_kept")) {
+    // A give under way when the cell was upgraded is undone as before: kept for its order again.
+    exec("ALTER TABLE parts ADD COLUMN from_kept INTEGER NOT NULL DEFAULT 0; "
+         "UPDATE parts SET from_kept = 1 WHERE place = 'in_transit'");
+  }
 }
 
 void CellStore::exec(const char* sql) const {

@@ -15,7 +15,7 @@ namespace {
 
 constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
-constexpr std::uint32_t kVersion = 4;  // 4: the triangle tree (TriangleMesh::bvh_nodes)
+constexpr std::uint32_t kVersion = 5;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept
 
 // FNV-1a, 64 bits: stable across runs and builds, which std::hash is not.
 std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665603ULL) {

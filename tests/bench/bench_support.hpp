@@ -53,15 +53,17 @@ struct Answers {
 
 // Writes `rounds` commands (after 20 warm-up rounds) on `topic` from `sender`, each after the
 // SUCCEEDED of the one before, heard on `answers_topic` by `listener`; the round trips, us.
-// `make(i)` makes the i-th command.
+// `make(i)` makes the i-th command; `settings`: the writer's (a robot's gives go in its own
+// partition, where a buffer under DDS-Security takes them).
 inline std::vector<double> round_trips(const dds::ParticipantPtr& sender, const dds::ParticipantPtr& listener,
                                        const std::string& topic, const std::string& answers_topic, int rounds,
-                                       const std::function<cell::Command(int)>& make) {
+                                       const std::function<cell::Command(int)>& make,
+                                       const dds::QosSettings& settings = {}) {
   Answers answers;
   EventReader reader(listener, answers_topic, dds::TopicKind::events, [&](const cell::CommandEvent& e) {
     if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id().to_string());
   });
-  CommandWriter writer(sender, topic, dds::TopicKind::events);
+  CommandWriter writer(sender, topic, dds::TopicKind::events, settings);
   if (!writer.wait_for_readers(1, std::chrono::seconds(20))) throw std::runtime_error("nobody reads " + topic);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the reader's side of the match, too
   std::vector<double> us;

@@ -223,15 +223,12 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
         up = start_up();
       } else if (const auto children = children_of(up->pid()); !children.empty()) {
         std::size_t pick = children.size();
-        for (auto kind = first_victims.begin(); kind != first_victims.end() && pick == children.size(); ++kind) {
-          for (std::size_t i = 0; i < children.size(); ++i) {
+        for (std::size_t k = 0; k < first_victims.size() && pick == children.size(); ++k) {
+          for (std::size_t i = 0; i < children.size() && pick == children.size(); ++i) {
             const auto& [name, pid] = children[i];
-            if (name == *kind && (name != "twin" || chaos_detail::identity_of(pid, name, store) != name)) {
-              pick = i;
-              first_victims.erase(kind);
-              break;
-            }
+            if (name == first_victims[k] && (name != "twin" || chaos_detail::identity_of(pid, name, store) != name)) pick = i;
           }
+          if (pick != children.size()) first_victims.erase(first_victims.begin() + static_cast<long>(k));
         }
         if (pick == children.size()) pick = random() % children.size();
         const auto& [name, pid] = children[pick];

@@ -326,7 +326,7 @@ class CaexReader {
   static bool is_collada(const std::filesystem::path& file) {
     std::string extension = file.extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return extension == ".dae";
+    return extension == ".dae" || extension == ".zae";  // COLLADA, and zipped COLLADA
   }
 
   MeshRef resolve_mesh(std::string uri, const SourceRef& where) const {
