@@ -62,7 +62,7 @@ void command_round_trips(const Mode& m, int rounds) {
     c.part_type("Part");
     c.destination("mobile-robot-1");
     return c;
-  }, dds::owned_by({"mobile-robot-1"}, dds::command_qos()));
+  }, dds::owned_by({"mobile-robot-1"}));
   report("security " + m.name + ": command to SUCCEEDED, buffer process", us);
   buffer.stop();
 }
