@@ -255,10 +255,20 @@ inline ChaosResult run_chaos(const ChaosOptions& o) {
       r.failures.push_back(order.order + ": still " + order.state);
     }
   }
+  // The last status once the cell is whole again (bounded): a process killed near the end is
+  // still coming back, and a killed cell-sim brings every other process back after it.
   const fs::path status = o.dir / "status.json";
-  if (cellctl({"status", "--json", "--cell", o.cell, "--domain", domain}, status, 30s) == 0) {
+  const auto whole = [&] {
+    if (cellctl({"status", "--json", "--cell", o.cell, "--domain", domain}, status, 30s) != 0) return false;
     r.status = nlohmann::json::parse(read_text(status), nullptr, false);
-  }
+    if (!r.status.is_object() || !r.status["resources"].is_array()) return false;
+    for (const auto& resource : r.status["resources"]) {
+      if (resource["alive"] != true) return false;
+    }
+    return true;
+  };
+  const auto settle_by = Clock::now() + 60s;
+  while (!whole() && Clock::now() < settle_by) std::this_thread::sleep_for(1s);
   r.down_ok = cellctl({"down", "--cell", o.cell, "--domain", domain}, o.dir / "down.log", 30s) == 0;
   up->wait_for_exit(20s);
   const auto deadline = Clock::now() + 10s;
