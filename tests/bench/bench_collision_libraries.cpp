@@ -20,34 +20,14 @@
 
 #include "sim/collision/collision_world.hpp"
 #include "sim/mesh/triangle_bvh.hpp"
+#include "tests/support/meshes.hpp"
 
 namespace {
 
-// A tube along y: `segments` around, from radius `inner` (0: a solid pin) to `outer`.
+// A tube (tests/support/meshes.hpp) with what loading finds (sim::load_mesh): convex or not,
+// hull corners, coarse hull, triangle tree.
 sim::TriangleMesh tube(int segments, double outer, double inner, double height) {
-  sim::TriangleMesh m;
-  m.pieces.emplace_back();
-  const bool solid = inner <= 0;
-  for (const double y : {0.0, height}) {
-    for (int k = 0; k < segments; ++k) {
-      const double t = 2 * M_PI * k / segments;
-      m.vertices.emplace_back(outer * std::cos(t), y, outer * std::sin(t));
-      m.vertices.emplace_back(solid ? 0 : inner * std::cos(t), y, solid ? 0 : inner * std::sin(t));
-    }
-  }
-  const auto o = [&](int level, int k) { return static_cast<std::uint32_t>(level * 2 * segments + 2 * (k % segments)); };
-  for (int k = 0; k < segments; ++k) {
-    const auto a = o(0, k), b = o(0, k + 1), c = o(1, k + 1), d = o(1, k);
-    m.triangles.insert(m.triangles.end(), {{a, c, b}, {a, d, c}});                      // outside
-    if (!solid) m.triangles.insert(m.triangles.end(), {{a + 1, b + 1, c + 1}, {a + 1, c + 1, d + 1}});  // bore
-    m.triangles.insert(m.triangles.end(), {{d, c + 1, c}, {d, d + 1, c + 1}});          // top
-    m.triangles.insert(m.triangles.end(), {{a, b, b + 1}, {a, b + 1, a + 1}});          // bottom
-  }
-  for (std::uint32_t i = 0; i < m.vertices.size(); ++i) {
-    m.pieces.back().push_back(i);
-    m.bounds.extend(m.vertices[i]);
-  }
-  // As loading does (sim::load_mesh): convex or not, hull corners, coarse hull, tree.
+  sim::TriangleMesh m = test::tube_mesh(segments, outer, inner, height);
   m.convex = sim::is_convex(m);
   m.hull_corners = sim::hull_corners(m);
   sim::make_coarse_hull(m);

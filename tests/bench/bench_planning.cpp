@@ -14,6 +14,7 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include "tests/support/meshes.hpp"
 #include "tests/support/wall_product.hpp"
 #include "twin/planning/assembly_planner.hpp"
 
@@ -85,23 +86,9 @@ std::filesystem::path ring_stack(int triangles, int rings, bool stl) {
   for (int r = 0; r < rings; ++r) {
     const std::string name = "ring" + std::to_string(r);
     const double outer = 0.020 + r * 1e-5, inner = 0.010;  // each file its own content
-    std::vector<Eigen::Vector3d> v;
-    for (const double y : {0.0, 0.005}) {
-      for (int k = 0; k < segments; ++k) {
-        const double t = 2 * M_PI * k / segments;
-        v.emplace_back(outer * std::cos(t), y, outer * std::sin(t));
-        v.emplace_back(inner * std::cos(t), y, inner * std::sin(t));
-      }
-    }
-    const auto o = [&](int level, int k) { return level * 2 * segments + 2 * (k % segments); };  // 0-based
-    std::vector<std::array<int, 3>> faces;
-    for (int k = 0; k < segments; ++k) {
-      const int a = o(0, k), b = o(0, k + 1), c = o(1, k + 1), d = o(1, k);
-      faces.insert(faces.end(), {{a, c, b}, {a, d, c}});                  // outside
-      faces.insert(faces.end(), {{a + 1, b + 1, c + 1}, {a + 1, c + 1, d + 1}});  // bore
-      faces.insert(faces.end(), {{d, c + 1, c}, {d, d + 1, c + 1}});      // top
-      faces.insert(faces.end(), {{a, b, b + 1}, {a, b + 1, a + 1}});      // bottom
-    }
+    const sim::TriangleMesh ring = test::tube_mesh(segments, outer, inner, 0.005);
+    const auto& v = ring.vertices;
+    const auto& faces = ring.triangles;
     const std::string mesh = name + (stl ? ".stl" : ".obj");
     if (stl) {
       std::ofstream out(dir / mesh, std::ios::binary);

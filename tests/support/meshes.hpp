@@ -1,7 +1,8 @@
 #pragma once
-// Meshes made in the tests: boxes, and a frame of one piece that is concave.
+// Meshes made in the tests: boxes, a frame of one piece that is concave, and tubes.
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "sim/mesh/triangle_mesh.hpp"
@@ -41,6 +42,35 @@ inline sim::TriangleMesh one_piece_frame(double hole, double bar, double thickne
   add_box(mesh, {-hole, -h, -out}, {hole, h, -hole});  // front
   add_box(mesh, {-hole, -h, hole}, {hole, h, out});    // back
   return mesh;
+}
+
+// A tube along y of one piece, as a CAD export of a ring writes it: `segments` around, from
+// radius `inner` to `outer` (m), `height` tall; `inner` 0: a solid pin. 8 triangles per
+// segment (6 for a pin), facing outwards. Only its shape: nothing of what loading finds.
+inline sim::TriangleMesh tube_mesh(int segments, double outer, double inner, double height) {
+  sim::TriangleMesh m;
+  m.pieces.emplace_back();
+  const bool solid = inner <= 0;
+  for (const double y : {0.0, height}) {
+    for (int k = 0; k < segments; ++k) {
+      const double t = 2 * M_PI * k / segments;
+      m.vertices.emplace_back(outer * std::cos(t), y, outer * std::sin(t));
+      m.vertices.emplace_back(solid ? 0 : inner * std::cos(t), y, solid ? 0 : inner * std::sin(t));
+    }
+  }
+  const auto o = [&](int level, int k) { return static_cast<std::uint32_t>(level * 2 * segments + 2 * (k % segments)); };
+  for (int k = 0; k < segments; ++k) {
+    const auto a = o(0, k), b = o(0, k + 1), c = o(1, k + 1), d = o(1, k);
+    m.triangles.insert(m.triangles.end(), {{a, c, b}, {a, d, c}});  // outside
+    if (!solid) m.triangles.insert(m.triangles.end(), {{a + 1, b + 1, c + 1}, {a + 1, c + 1, d + 1}});  // bore
+    m.triangles.insert(m.triangles.end(), {{d, c + 1, c}, {d, d + 1, c + 1}});  // top
+    m.triangles.insert(m.triangles.end(), {{a, b, b + 1}, {a, b + 1, a + 1}});  // bottom
+  }
+  for (std::uint32_t i = 0; i < m.vertices.size(); ++i) {
+    m.pieces.back().push_back(i);
+    m.bounds.extend(m.vertices[i]);
+  }
+  return m;
 }
 
 }  // namespace test
