@@ -133,6 +133,7 @@ fb::Data to_data(const cell::Command& c) {
           {"source_award", c.source_award().to_string()},
           {"path", to_numbers(c.path())},
           {"opening", c.opening()},
+          {"carried", names(c.carried())},
           {"sim_time", c.sim_time()}};
 }
 
@@ -150,6 +151,7 @@ cell::Command to_command(const fb::Data& d) {
   c.source_award(id(d, "source_award"));
   c.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
   c.opening(fb::get_or<double>(d, "opening", 0));
+  c.carried(ids(d, "carried"));
   c.sim_time(fb::get_or<double>(d, "sim_time", 0));
   return c;
 }

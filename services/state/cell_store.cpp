@@ -295,20 +295,22 @@ std::map<std::string, std::map<std::string, int>> CellStore::kept(const std::str
   return out;
 }
 
-void CellStore::move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
-                          const char* from) {
+void CellStore::move_parts(const std::string& order, const std::vector<std::string>& parts, Place to,
+                           const std::string& holder, const char* from, const char* or_from) {
   Transaction t(*this);
-  Statement(db_, "UPDATE parts SET place = ?, holder = ? WHERE order_id = ? AND part = ? AND place = ?")
-      .bind(place_name(to), holder, order, part, from)
-      .step();
-  if (sqlite3_changes(db_) != 1) {
-    // The part was not where this move starts (handed out before the cell kept state, or
-    // moved by a process that was killed before it could say so): the journal tells.
-    t.commit();
-    journal(holder, std::string("unexpected ") + place_name(to), order, part + " was not " + from);
-    return;
+  std::vector<std::string> elsewhere;
+  for (const std::string& part : parts) {
+    Statement(db_, "UPDATE parts SET place = ?, holder = ? WHERE order_id = ? AND part = ? AND place IN (?, ?)")
+        .bind(place_name(to), holder, order, part, from, or_from ? or_from : from)
+        .step();
+    if (sqlite3_changes(db_) != 1) elsewhere.push_back(part);
   }
   t.commit();
+  // A part that was not where this move starts (handed out before the cell kept state, or
+  // moved by a process that was killed before it could say so): the journal tells.
+  for (const std::string& part : elsewhere) {
+    journal(holder, std::string("unexpected ") + place_name(to), order, part + " was not " + from);
+  }
 }
 
 void CellStore::deliver(const std::string& order, const std::string& part, const std::string& station) {
@@ -322,20 +324,21 @@ void CellStore::deliver(const std::string& order, const std::string& part, const
   if (!moved) journal(station, "unexpected on_station", order, part + " was not in_transit");
 }
 
-void CellStore::grip(const std::string& order, const std::string& part, const std::string& arm) {
-  move_part(order, part, Place::in_gripper, arm, "on_station");
+void CellStore::grip(const std::string& order, const std::vector<std::string>& parts, const std::string& arm) {
+  // At the dock, or placed in a subassembly built aside that the arm now carries whole.
+  move_parts(order, parts, Place::in_gripper, arm, "on_station", "placed");
 }
 
-void CellStore::release(const std::string& order, const std::string& part) {
-  move_part(order, part, Place::on_station, "", "in_gripper");
+void CellStore::release(const std::string& order, const std::vector<std::string>& parts) {
+  move_parts(order, parts, Place::on_station, "", "in_gripper");
 }
 
-void CellStore::place(const std::string& order, const std::string& part) {
-  move_part(order, part, Place::placed, "", "on_station");
+void CellStore::place(const std::string& order, const std::vector<std::string>& parts, const std::string& aside) {
+  move_parts(order, parts, Place::placed, aside, "on_station");
 }
 
 void CellStore::set_aside(const std::string& order, const std::string& part) {
-  move_part(order, part, Place::inspection, "", "in_gripper");
+  move_parts(order, {part}, Place::inspection, "", "in_gripper");
 }
 
 void CellStore::assemble(const std::string& order) {

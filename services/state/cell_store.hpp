@@ -38,7 +38,8 @@ struct PartCount {
 };
 
 struct PartRecord {
-  std::string order, part, part_type, buffer, holder;
+  std::string order, part, part_type, buffer;
+  std::string holder;   // the robot or arm that holds it; placed: the subassembly built aside it is in
   Place place = Place::in_transit;
   std::string station;  // where it was delivered
 };
@@ -110,10 +111,12 @@ class CellStore {
   std::map<std::string, std::map<std::string, int>> kept(const std::string& buffer) const;
   // The part reached `station` (a robot put it down at its dock).
   void deliver(const std::string& order, const std::string& part, const std::string& station);
-  void grip(const std::string& order, const std::string& part, const std::string& arm);
-  void release(const std::string& order, const std::string& part);
-  // Assembled into the product on the station (its step is done); set aside for inspection.
-  void place(const std::string& order, const std::string& part);
+  // Several parts at once: a subassembly, gripped by its base, carried and released whole.
+  void grip(const std::string& order, const std::vector<std::string>& parts, const std::string& arm);
+  void release(const std::string& order, const std::vector<std::string>& parts);
+  // Assembled into the product on the station (their step is done), or into the subassembly
+  // `aside` built beside it (its name stands as their holder until it is inserted).
+  void place(const std::string& order, const std::vector<std::string>& parts, const std::string& aside = "");
   void set_aside(const std::string& order, const std::string& part);
   // The order's product is finished: its parts on the station become assembled.
   void assemble(const std::string& order);
@@ -167,8 +170,9 @@ class CellStore {
   // The part, on its way, goes back to the buffer it came from (within a transaction).
   void put_back(const PartRecord& part);
   std::vector<PartRecord> parts_held(const std::string& holder, Place place) const;
-  void move_part(const std::string& order, const std::string& part, Place to, const std::string& holder,
-                 const char* from);
+  // In one transaction: each part that is `from` (or `or_from`) goes `to`.
+  void move_parts(const std::string& order, const std::vector<std::string>& parts, Place to, const std::string& holder,
+                  const char* from, const char* or_from = nullptr);
   sqlite3* db_ = nullptr;
 };
 

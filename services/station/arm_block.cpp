@@ -1,10 +1,14 @@
 #include "services/station/arm_block.hpp"
 
+#include <set>
 #include <sstream>
 
 #include "services/state/cell_store.hpp"
 
 namespace fb {
+namespace {
+constexpr std::size_t kMaxCarried = 64;  // a subassembly's members: far more than any has
+}  // namespace
 
 ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
     : DeviceBlock(std::move(name), id, {"grip", "translate", "rotate", "release", "connect", "disconnect"}),
@@ -30,14 +34,18 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
       sim_.act_for(get_or<std::string>(d, "order_id", ""));
       std::vector<std::string> carried = gripper_bodies();
       carried.erase(carried.begin());  // the palm leads
-      if (!held_.empty()) carried.push_back(held_);
+      if (!held_.empty()) {
+        const auto held = held_bodies();
+        carried.insert(carried.end(), held.begin(), held.end());
+      }
       awaited_ = 1;
       request(sim_.move(gripper_bodies().front(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
     }, op(motion));
   }
   transition("READY", "START", "READY", [this](const Data&) {
-    if (store() && !held_.empty()) store()->release(held_order_, held_);
+    if (store() && !held_.empty()) store()->release(held_order_, held_bodies());
     held_.clear();
+    carried_.clear();
     emit("DONE");
   }, op("release"));
   for (const char* joining : {"connect", "disconnect"}) {
@@ -80,6 +88,11 @@ void ArmBlock::check(const Data& command, SampleCheck& c) const {
     std::ostringstream why;
     why << "opening: " << opening << " m is wider than the gripper opens (" << settings_.gripper.max_opening << " m)";
     c.require(!(opening > settings_.gripper.max_opening), why.str());
+    c.names("carried", kMaxCarried);
+    const auto carried = split_names(get_or<std::string>(command, "carried", ""));
+    const std::set<std::string> distinct(carried.begin(), carried.end());
+    c.require(distinct.size() == carried.size() && !distinct.count(get<std::string>(command, "part")),
+              "carried: names a body twice, or the gripped part");
   } else if (operation == "translate" || operation == "rotate") {
     c.poses("path", 1);
   } else if (operation == "connect" || operation == "disconnect") {
@@ -105,9 +118,16 @@ void ArmBlock::grip(const Data& d) {
   has_gripper_ = true;
   held_ = get<std::string>(d, "part");
   held_order_ = get_or<std::string>(d, "order_id", "");
+  carried_ = split_names(get_or<std::string>(d, "carried", ""));
   // In the gripper from the moment the grip begins: a part half gripped when the arm's
-  // process ends is one for inspection.
-  if (store() && !held_.empty()) store()->grip(held_order_, held_, resource_id());
+  // process ends is one for inspection, and so is every part it carries.
+  if (store() && !held_.empty()) store()->grip(held_order_, held_bodies(), resource_id());
+}
+
+std::vector<std::string> ArmBlock::held_bodies() const {
+  std::vector<std::string> out{held_};
+  out.insert(out.end(), carried_.begin(), carried_.end());
+  return out;
 }
 
 std::vector<std::string> ArmBlock::gripper_bodies() const {

@@ -236,7 +236,7 @@ TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "
   CHECK(report.find(" s, aborted</title>") == std::string::npos);
 }
 
-TEST_CASE("cell up: a bad order and one with a subassembly fail alone, the cell stays idle and usable, down ends it", "[process][cell]") {
+TEST_CASE("cell up: a bad order fails alone, one with a subassembly is built, the cell stays idle and usable, down ends it", "[process][cell]") {
   test::clean_stale_dds_segments();
   const fs::path dir = scratch("bad-order");
   const std::string domain = "188";
@@ -251,15 +251,22 @@ TEST_CASE("cell up: a bad order and one with a subassembly fail alone, the cell 
   CHECK(bad == 2);
   CHECK(bad_log.find("unknown_link_id.aml:") != std::string::npos);  // file and line
 
-  // Planned, but not a product this cell builds: the order fails with why, the plan is kept.
+  // Shaft and pendulum built aside as one, then inserted whole: every part ends assembled.
   const int nested = cellctl({"submit", std::string(TEST_DATA_DIR) + "/planning/cranfield-subassembly/cranfield-subassembly.aml",
                               "--domain", domain, "--order", "nested", "--out", (dir / "nested").string()},
                              dir / "nested.log");
   const std::string nested_log = read_text(dir / "nested.log");
-  INFO(nested_log);
-  CHECK(nested == 1);
-  CHECK(nested_log.find("subassemblies (ShaftPendulum)") != std::string::npos);
-  CHECK(fs::exists(dir / "nested" / "plan.json"));
+  INFO(nested_log << read_text(dir / "up.log"));
+  CHECK(nested == 0);
+  CHECK(nested_log.find("assembled 9 parts") != std::string::npos);
+  {
+    const auto parts = state::CellStore(dir / "state").parts("nested");
+    CHECK(parts.size() == 9);
+    for (const auto& p : parts) {
+      INFO(p.part);
+      CHECK(p.place == state::Place::assembled);
+    }
+  }
 
   const int good = cellctl({"submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain", domain,
                             "--order", "good", "--out", (dir / "good").string()},

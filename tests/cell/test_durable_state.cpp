@@ -138,7 +138,8 @@ std::set<std::string> wait_for_placed(const fs::path& state_dir, const std::stri
 }
 
 // Every part in place before stays the one assembled: none was fetched or placed again.
-void check_taken_up(const fs::path& state_dir, const std::string& order, const std::set<std::string>& placed_before) {
+void check_taken_up(const fs::path& state_dir, const std::string& order, const std::set<std::string>& placed_before,
+                    std::size_t parts) {
   state::CellStore store(state_dir);
   std::set<std::string> assembled, all;
   for (const auto& p : store.parts(order)) {
@@ -146,7 +147,7 @@ void check_taken_up(const fs::path& state_dir, const std::string& order, const s
     if (p.place == state::Place::assembled) assembled.insert(p.part);
   }
   INFO("parts of " << order << ": " << all.size());
-  CHECK(assembled.size() == 11);  // the Lego tower
+  CHECK(assembled.size() == parts);
   for (const auto& part : placed_before) {
     INFO(part);
     CHECK(assembled.count(part) == 1);
@@ -182,9 +183,44 @@ TEST_CASE("a twin killed during physical assembly is started again and finishes 
   INFO(test::read_text(dir / "submit.log") << test::read_text(log));
   CHECK(code == 0);
   CHECK(test::read_text(log).find("order tower: twin started again (attempt 2)") != std::string::npos);
-  check_taken_up(state_dir, "tower", placed);
+  check_taken_up(state_dir, "tower", placed, 11);
   const json status = status_json(domain, dir);
   for (const auto& r : status["resources"]) CHECK(r["reserved_by"] == "");
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("a twin killed once a subassembly stands built aside: the next one inserts it as it stands",
+          "[process][cell][state][subassembly]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("subassembly-resume");
+  const fs::path state_dir = dir / "state", log = dir / "up.log";
+  const std::string domain = "202";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir",
+                         state_dir.string()},
+                        log.string());
+  REQUIRE(test::appears(log, "cell up on domain"));
+  test::ChildProcess submit({CELLCTL_EXE, "submit",
+                             std::string(TEST_DATA_DIR) + "/planning/cranfield-subassembly/cranfield-subassembly.aml",
+                             "--domain", domain, "--order", "nested", "--out", (dir / "nested").string()},
+                            (dir / "submit.log").string());
+  // The plan's first two steps build shaft and pendulum aside.
+  const auto aside = wait_for_placed(state_dir, "nested", 2);
+  REQUIRE(aside.size() >= 2);
+  const pid_t twin = test::twin_of(state::CellStore(state_dir), "nested");
+  REQUIRE(twin > 0);
+  ::kill(twin, SIGKILL);
+  {
+    state::CellStore store(state_dir);
+    std::size_t in_subassembly = 0;
+    for (const auto& p : store.parts("nested")) in_subassembly += p.place == state::Place::placed && p.holder == "ShaftPendulum";
+    CHECK(in_subassembly >= 1);  // the state knows they stand aside, not in the product
+  }
+  const int code = submit.wait_for_exit(150s);
+  INFO(test::read_text(dir / "submit.log") << test::read_text(log));
+  CHECK(code == 0);
+  CHECK(test::read_text(log).find("order nested: twin started again (attempt 2)") != std::string::npos);
+  check_taken_up(state_dir, "nested", aside, 9);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }
@@ -215,7 +251,7 @@ TEST_CASE("cellctl down pauses the orders under way, and up on the same state ta
   const int code = submit.wait_for_exit(150s);  // it follows the order across the pause
   INFO(test::read_text(dir / "submit.log") << test::read_text(dir / "up-1.log") << test::read_text(dir / "up-2.log"));
   CHECK(code == 0);
-  check_taken_up(state_dir, "paused", placed);
+  check_taken_up(state_dir, "paused", placed, 11);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down-2.log", 30s) == 0);
   CHECK(up->wait_for_exit(20s) == 0);
 }

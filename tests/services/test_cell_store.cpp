@@ -79,10 +79,10 @@ TEST_CASE("a part moves buffer, robot, station, gripper, product, and is counted
   require_conserved(store);
   store.deliver("o1", "o1/peg", "station-1");
   CHECK(count("Peg").on_stations == 1);
-  store.grip("o1", "o1/peg", "arm-1");
+  store.grip("o1", {"o1/peg"}, "arm-1");
   CHECK(count("Peg").on_stations == 1);  // in the gripper, at the station
   CHECK(store.parts("o1").front().place == state::Place::in_gripper);
-  store.release("o1", "o1/peg");
+  store.release("o1", {"o1/peg"});
   store.assemble("o1");
   CHECK(count("Peg").assembled == 1);
   CHECK(count("Peg").on_stations == 0);
@@ -103,7 +103,7 @@ TEST_CASE("a part moves buffer, robot, station, gripper, product, and is counted
     store.give("buffer-1", "Peg", "o2", "o2/peg", "robot-1");
     store.give("buffer-1", "Plate", "o2", "o2/plate", "robot-2");
     store.deliver("o2", "o2/plate", "station-1");
-    store.grip("o2", "o2/plate", "arm-1");
+    store.grip("o2", {"o2/plate"}, "arm-1");
     const auto returned = store.return_carried("robot-1");
     REQUIRE(returned.size() == 1);
     CHECK(returned.front().part == "o2/peg");

@@ -61,6 +61,8 @@ struct Outcome {
   std::vector<std::string> statuses;  // messages
   std::vector<std::string> order;     // what went out: "SIM spawn", "CFP host", ...
   std::vector<Data> grips;            // the grip commands
+  std::vector<Data> placed;           // PLACED events
+  std::vector<Data> moves;            // cell-sim moves
   std::optional<Data> quote;
   bool finished = false, complete = false;
   std::string error;
@@ -143,6 +145,7 @@ Outcome run(Twin& t, const Cell& cell) {
       const std::string& kind = get<std::string>(e.data, "kind");
       out.order.push_back("SIM " + kind);
       if (kind == "spawn") out.spawned.push_back(get<std::string>(e.data, "body_id"));
+      if (kind == "move") out.moves.push_back(e.data);
       const bool collided = kind == "move" && cell.collide(e.data, std::count(out.order.begin(), out.order.end(), "SIM set_static"));
       more = t.send("orchestrator", "SIM_REPLY",
                     {{"request_id", e.data.at("request_id")}, {"ok", true}, {"error", std::string()},
@@ -166,6 +169,7 @@ Outcome run(Twin& t, const Cell& cell) {
       queued_reported |= out.statuses.back().find("orders ahead") != std::string::npos;
     } else if (e.name == "PLACED") {
       out.order.push_back("PLACED");
+      out.placed.push_back(e.data);
     } else if (e.name == "FINDING") {
       out.findings.push_back(get<std::string>(e.data, "kind"));
     } else if (e.name == "FINISHED") {
@@ -226,6 +230,57 @@ TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holdin
     const twin::Quat turned(pose[3], pose[4], pose[5], pose[6]);
     CHECK(turned.angularDistance(twin::Quat(planned.waypoints.front().gripper.linear())) < 1e-9);
   }
+}
+
+TEST_CASE("orchestrator: a subassembly is built aside, then gripped by its base and inserted whole, virtually and physically",
+          "[twin][orchestration][subassembly]") {
+  const test::Planned nested(std::filesystem::path(TEST_DATA_DIR) / "planning/cranfield-subassembly/cranfield-subassembly.aml");
+  const twin::Plan& plan = nested.plan;
+  REQUIRE(plan.complete);
+  REQUIRE(plan.subassemblies.size() == 1);
+  const twin::SubassemblyPlan& unit = plan.subassemblies.front();
+  const auto& parts = nested.product.product.parts();
+  const std::size_t part_count = parts.size();
+  REQUIRE(plan.steps.size() == part_count + 1);  // each part, and the step inserting the unit
+  Twin t(nested.product, plan);
+  const Outcome out = run(t, Cell{});
+  INFO(out.error);
+  REQUIRE(out.complete);
+
+  // Virtual assembly: the unit's insertion moves every member with the gripper.
+  const auto inserting = std::find_if(out.moves.begin(), out.moves.end(), [&](const Data& move) {
+    return std::all_of(unit.members.begin(), unit.members.end(),
+                       [&](twin::PartIndex p) { return carries(move, "o1/virtual/" + parts[p].name); });
+  });
+  CHECK(inserting != out.moves.end());
+
+  // Physical: one fetch per part, none for the unit; one grip per step.
+  CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND fetch") == static_cast<long>(part_count));
+  REQUIRE(out.grips.size() == plan.steps.size());
+  std::vector<std::string> members;
+  for (twin::PartIndex p : unit.members) members.push_back("o1/" + parts[p].name);
+  const auto unit_grip = std::find_if(out.grips.begin(), out.grips.end(),
+                                      [](const Data& g) { return !get<std::string>(g, "carried").empty(); });
+  REQUIRE(unit_grip != out.grips.end());
+  CHECK(get<std::string>(*unit_grip, "part") == members.front());  // by its base
+  CHECK(fb::split_names(get<std::string>(*unit_grip, "carried")) == std::vector<std::string>(members.begin() + 1, members.end()));
+  // Built aside and connected there: each member is made movable before the grip, and
+  // connected again after the insertion.
+  CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND disconnect") == static_cast<long>(members.size()));
+  CHECK(std::count(out.order.begin(), out.order.end(), "COMMAND connect") == static_cast<long>(part_count + members.size()));
+
+  // The members are recorded in their subassembly aside, then in place all at once.
+  REQUIRE(out.placed.size() == plan.steps.size());
+  std::vector<std::string> aside, inserted;
+  for (const Data& placed : out.placed) {
+    if (get<std::string>(placed, "aside") == unit.name) aside.push_back(get<std::string>(placed, "part"));
+    if (fb::split_names(get<std::string>(placed, "part")).size() > 1) {
+      CHECK(get<std::string>(placed, "aside").empty());
+      inserted = fb::split_names(get<std::string>(placed, "part"));
+    }
+  }
+  CHECK(aside == members);
+  CHECK(inserted == members);
 }
 
 TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on when the station is its", "[twin][orchestration]") {

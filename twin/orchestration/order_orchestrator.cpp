@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "services/blocks/sample_checks.hpp"
+#include "twin/planning/subassembly_planner.hpp"
 
 namespace twin {
 namespace {
@@ -19,6 +21,17 @@ Pose with_translation(Pose pose, double x, double y, double z) {
   pose.translation() = Vec3(x, y, z);
   return pose;
 }
+
+// A part (or a subassembly) standing at `from` carried to where its trajectory starts: up to
+// the higher of the two (at least `least`), over, then down to the start.
+std::vector<Pose> lift_over(const Pose& from, const Pose& start, double least) {
+  const double safe = std::max({from.translation().y(), start.translation().y(), least});
+  return {with_translation(from, from.translation().x(), safe, from.translation().z()),
+          with_translation(start, start.translation().x(), safe, start.translation().z()), start};
+}
+
+// The step puts a whole subassembly in (its part is the base; `carried`, the other members).
+bool inserts_unit(const PlanStep& step) { return !step.carried.empty(); }
 
 double path_length(const std::vector<Pose>& poses) {
   double length = 0;
@@ -50,7 +63,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
-  declare_output("PLACED", {"part"});
+  declare_output("PLACED", {"part", "aside"});
   declare_output("FINISHED", {"complete", "error", "take_up"});
 
   const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
@@ -216,8 +229,11 @@ std::vector<double> OrderOrchestrator::arm_times() const {
     const auto& w = step.trajectory.waypoints;
     std::vector<Pose> poses;
     for (const auto& p : w) poses.push_back(p.gripper);
-    // From the dock to where the trajectory starts, along it, and back to the dock.
-    const double to_start = (w.front().part.translation() - Vec3(dock[0], dock[1], dock[2])).norm();
+    // From the dock (or where its subassembly stands aside) to where the trajectory starts,
+    // along it, and back.
+    const SubassemblyPlan* unit = inserts_unit(step) ? subassembly_of(step) : nullptr;
+    const Vec3 from = unit ? aside_pose(step.part, *unit).translation() : Vec3(dock[0], dock[1], dock[2]);
+    const double to_start = (w.front().part.translation() - from).norm();
     out.push_back((2 * to_start + path_length(poses)) / speed);
   }
   return out;
@@ -296,7 +312,9 @@ void OrderOrchestrator::report_place(long ahead) {
 
 std::map<std::string, int> OrderOrchestrator::parts_per_type() const {
   std::map<std::string, int> out;
-  for (const auto& step : plan_.steps) ++out[short_type_name(product_.product.parts()[step.part].type)];
+  for (const auto& step : plan_.steps) {
+    if (!inserts_unit(step)) ++out[short_type_name(product_.product.parts()[step.part].type)];
+  }
   return out;
 }
 
@@ -401,6 +419,10 @@ std::vector<double> OrderOrchestrator::fetch_times() const {
   const auto robot = places_.find(robot_);
   const Numbers* at = robot == places_.end() || robot->second.position.size() < 3 ? nullptr : &robot->second.position;
   for (const auto& step : plan_.steps) {
+    if (inserts_unit(step)) {  // its parts came with their own steps
+      distances.push_back(0);
+      continue;
+    }
     const Numbers* from = dock(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
     if (!to || !at || !from) break;
     distances.push_back(flat(*at, *from) + flat(*from, *to));
@@ -459,6 +481,38 @@ std::string OrderOrchestrator::physical_body(PartIndex part) const {
   return settings_.order_id + "/" + product_.product.parts()[part].name;
 }
 
+const SubassemblyPlan* OrderOrchestrator::subassembly_of(const PlanStep& step) const {
+  for (const auto& unit : plan_.subassemblies) {
+    if (unit.name == step.subassembly) return &unit;
+  }
+  return nullptr;
+}
+
+double OrderOrchestrator::above_asides(const PlanStep& step, const Pose& pose) const {
+  constexpr double kClearance = 0.02;  // m
+  double top = -std::numeric_limits<double>::infinity();
+  for (const auto& unit : plan_.subassemblies) top = std::max(top, final_bounds(product_, unit.members).max().y() + unit.aside.y());
+  if (!std::isfinite(top)) return top;
+  // How far the moving parts reach below `pose`, turned as it is.
+  const Pose& base = product_.product.parts()[step.part].final_pose;
+  std::vector<PartIndex> moving{step.part};
+  moving.insert(moving.end(), step.carried.begin(), step.carried.end());
+  Pose turned = Pose::Identity();
+  turned.linear() = pose.rotation();
+  double below = 0;
+  for (PartIndex p : moving) {
+    const Pose offset = turned * base.inverse() * product_.product.parts()[p].final_pose;
+    for (const auto& v : product_.meshes[p]->vertices) below = std::min(below, (offset * v).y());
+  }
+  return top + kClearance - below;
+}
+
+Pose OrderOrchestrator::aside_pose(PartIndex part, const SubassemblyPlan& unit) const {
+  Pose pose = product_.product.parts()[part].final_pose;
+  pose.pretranslate(unit.aside);
+  return pose;
+}
+
 Data OrderOrchestrator::command(const std::string& resource, const std::string& operation, const std::string& part) {
   const std::string attempt = settings_.resume.attempt > 1 ? "r" + std::to_string(settings_.resume.attempt) + "/" : "";
   return {{"command_id", settings_.order_id + "/" + attempt + std::to_string(++command_count_) + "/" + operation},
@@ -471,6 +525,7 @@ Data OrderOrchestrator::command(const std::string& resource, const std::string& 
 void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   const PartIndex part = plan_.steps[step].part;
   const Trajectory t = candidates(step)[candidate];
+  if (inserts_unit(plan_.steps[step])) return add_unit_candidate(step, t);
   const std::string body = virtual_body(part);
   const std::vector<std::string> gripper = virtual_gripper();
   const std::string& scene = settings_.order_id;
@@ -505,6 +560,53 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   }
 }
 
+// A subassembly built aside in the order's scene, inserted whole along one candidate: its
+// parts spawned where they stand aside (again after a collision), the gripper at the grasp on
+// its base, up and over to the trajectory, along it, backing out.
+void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t) {
+  const PlanStep& unit_step = plan_.steps[step];
+  const SubassemblyPlan* unit = subassembly_of(unit_step);
+  const std::string& scene = settings_.order_id;
+  std::vector<PartIndex> members{unit_step.part};
+  members.insert(members.end(), unit_step.carried.begin(), unit_step.carried.end());
+  for (PartIndex member : members) {
+    const std::string body = virtual_body(member);
+    const MeshRef& mesh = *product_.product.parts()[member].mesh;
+    actions_.push_back({Action::sim, sim_.remove(body), false, true});
+    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at(virtual_station_, aside_pose(member, *unit))}),
+                                                {0, 0, 0}, false, mesh.file.string(), scene, mesh.scale)});
+    spawned_.insert(body);
+  }
+  const auto& w = t.waypoints;
+  const Pose grip = w.front().part.inverse() * w.front().gripper;
+  const Pose standing = at(virtual_station_, aside_pose(unit_step.part, *unit));
+  const std::vector<std::string> gripper = virtual_gripper();
+  const auto boxes = fb::gripper_boxes(settings_.gripper, t.grasp.opening);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const Vec3& h = boxes[i].half_extents;
+    actions_.push_back({Action::sim, sim_.spawn(gripper[i], fb::pose_numbers(standing * grip * boxes[i].pose),
+                                                {h.x(), h.y(), h.z()}, false, "", scene)});
+  }
+  spawned_.insert(gripper.begin(), gripper.end());
+  std::vector<Pose> holding, retreat;
+  const double least = above_asides(unit_step, w.front().part) + places_.at(virtual_station_).position[1];
+  for (const Pose& p : lift_over(standing, at(virtual_station_, w.front().part), least)) holding.push_back(p * grip);
+  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
+  const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
+  std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
+  for (PartIndex member : members) carried.push_back(virtual_body(member));
+  actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers(holding), v, omega), true});
+  carried.resize(gripper.size() - 1);
+  if (!retreat.empty()) {
+    actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers(retreat), v, omega), true});
+  }
+  for (PartIndex member : members) actions_.push_back({Action::sim, sim_.set_static(virtual_body(member), true)});
+  for (const auto& g : gripper) {
+    actions_.push_back({Action::sim, sim_.remove(g)});
+    spawned_.erase(g);
+  }
+}
+
 std::vector<std::string> OrderOrchestrator::virtual_gripper() const {
   std::vector<std::string> out;
   for (const auto& box : fb::gripper_boxes(settings_.gripper, 0)) out.push_back(settings_.order_id + "/virtual/gripper-" + box.name);
@@ -522,6 +624,7 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
   action_running_ = false;
   std::vector<std::string> left = virtual_gripper();
   left.push_back(virtual_body(part));
+  for (PartIndex p : plan_.steps[step_].carried) left.push_back(virtual_body(p));
   for (const auto& body : left) {
     actions_.push_back({Action::sim, sim_.remove(body)});
     spawned_.erase(body);
@@ -534,6 +637,12 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
 void OrderOrchestrator::back_to_sequence_planning() {
   const PartIndex part = plan_.steps[step_].part;
   const std::string& name = product_.product.parts()[part].name;
+  if (!plan_.subassemblies.empty()) {
+    // The planner takes steps already done only for a product without subassemblies.
+    return fail("virtual assembly found no collision-free path in cell-sim for " + step_name(product_.product, plan_.steps[step_]) +
+                " at step " + std::to_string(step_ + 1) + ", and a product with subassemblies is not planned again " +
+                "from a part-way assembly; see the findings");
+  }
   barred_.erase(barred_.upper_bound(step_), barred_.end());
   barred_[step_].insert(part);
   PlannerOptions options;
@@ -562,19 +671,21 @@ void OrderOrchestrator::back_to_sequence_planning() {
   next_action();
 }
 
-// Grip, move along the gripper's poses while holding, release, back out, connect.
-void OrderOrchestrator::add_arm_moves(const std::string& body, const std::vector<Pose>& holding,
-                                      const std::vector<Pose>& retreat) {
+// After the grip: move along the gripper's poses while holding, release, back out, connect.
+void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, const std::vector<Pose>& holding,
+                                      const std::vector<Pose>& retreat, const std::string& aside) {
   const bool turns = std::any_of(holding.begin(), holding.end(),
                                  [&](const Pose& p) { return !p.linear().isApprox(holding.front().linear(), 1e-9); });
-  Data move = command(arm_, turns ? "rotate" : "translate", body);
+  Data move = command(arm_, turns ? "rotate" : "translate", bodies.front());
   move["path"] = pose_numbers(holding);
   actions_.push_back({Action::command, move});
-  actions_.push_back({Action::command, command(arm_, "release", body)});
-  Data back = command(arm_, "translate", body);
+  const Data release = command(arm_, "release", bodies.front());
+  placed_by_[get<std::string>(release, "command_id")] = {{"part", fb::join_names(bodies)}, {"aside", aside}};
+  actions_.push_back({Action::command, release});
+  Data back = command(arm_, "translate", bodies.front());
   back["path"] = pose_numbers(retreat);
   actions_.push_back({Action::command, back});
-  actions_.push_back({Action::command, command(arm_, "connect", body)});
+  for (const auto& body : bodies) actions_.push_back({Action::command, command(arm_, "connect", body)});
 }
 
 namespace {
@@ -608,20 +719,33 @@ void OrderOrchestrator::plan_physical() {
       actions_.push_back({Action::sim, sim_.remove(body), false, true});
     }
   }
-  std::vector<std::string> fetches, bodies;
-  std::vector<std::size_t> steps;  // the steps to do
+  std::vector<std::string> fetches, bodies;  // per step to do: what to await ("": nothing), its body
+  std::vector<std::size_t> steps;              // the steps to do
+  std::map<PartIndex, std::string> body_of;
   for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
     const auto& step = plan_.steps[i];
+    if (inserts_unit(step)) {  // its parts were built aside by the steps before
+      if (!body_in(resume.placed, body_of.at(step.part))) {
+        steps.push_back(i);
+        fetches.emplace_back();
+        bodies.push_back(body_of.at(step.part));
+      }
+      continue;
+    }
     const auto& part = product_.product.parts()[step.part];
     const std::string type = short_type_name(part.type);
     const Pose final_pose = at(station_, part.final_pose);
     std::string body = physical_body(step.part);
     const std::string mesh = part.mesh->file.string();
     const double scale = part.mesh->scale;
-    if (const std::string* placed = body_in(resume.placed, body)) {  // done: it stands in the product
-      body = *placed;
-      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({final_pose}), {0, 0, 0}, true, mesh, "", scale)});
+    const std::string* placed = body_in(resume.placed, body);  // done: it stands in the product
+    const std::string* aside = body_in(resume.aside, body);    // done: it stands in its subassembly aside
+    if (placed || aside) {
+      body = placed ? *placed : *aside;
+      const Pose where = placed ? final_pose : at(station_, aside_pose(step.part, *subassembly_of(step)));
+      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({where}), {0, 0, 0}, true, mesh, "", scale)});
       spawned_.insert(body);
+      body_of[step.part] = body;
       continue;
     }
     steps.push_back(i);
@@ -633,6 +757,7 @@ void OrderOrchestrator::plan_physical() {
       fetches.push_back("delivered/" + body);
       delivered_.insert(fetches.back());
       bodies.push_back(body);
+      body_of[step.part] = body;
       continue;
     }
     if (body_in(resume.used, body)) body += "/r" + std::to_string(resume.attempt);  // the one before was set aside
@@ -642,6 +767,7 @@ void OrderOrchestrator::plan_physical() {
     actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, mesh, "", scale)});
     spawned_.insert(body);
     bodies.push_back(body);
+    body_of[step.part] = body;
     Data fetch = command(robot_, "fetch", body);
     fetch["part_type"] = type;
     fetch["source"] = buffer;
@@ -652,27 +778,35 @@ void OrderOrchestrator::plan_physical() {
     actions_.push_back({Action::send_only, fetch});
   }
   for (std::size_t k = 0; k < steps.size(); ++k) {
-    const PartIndex part = plan_.steps[steps[k]].part;
-    const Trajectory& t = plan_.steps[steps[k]].trajectory;
+    const PlanStep& step = plan_.steps[steps[k]];
+    const Trajectory& t = step.trajectory;
     const auto& w = t.waypoints;
-    const std::string& body = bodies[k];
-    actions_.push_back({Action::await_delivery, {{"command_id", fetches[k]}}});
-    // Delivered at the dock; carried up, over to where the trajectory starts, then along it.
+    const SubassemblyPlan* unit = subassembly_of(step);
+    std::vector<std::string> moved{bodies[k]};
+    for (PartIndex p : step.carried) moved.push_back(body_of.at(p));
     const Pose grip = w.front().part.inverse() * w.front().gripper;
     const Pose start = at(station_, w.front().part);
-    const Pose delivered =
-        with_translation(start, dock[0], at(station_, product_.product.parts()[part].final_pose).translation().y(), dock[2]);
-    const double safe = std::max(delivered.translation().y(), start.translation().y());
-    std::vector<Pose> part_path = {with_translation(delivered, dock[0], safe, dock[2]),
-                                   with_translation(start, start.translation().x(), safe, start.translation().z()), start};
-    Data take = command(arm_, "grip", body);
-    take["path"] = pose_numbers({delivered * grip});
+    Pose standing;  // where the arm grips it
+    if (inserts_unit(step)) {
+      // Built aside and connected there: movable again, gripped by its base.
+      standing = at(station_, aside_pose(step.part, *unit));
+      for (const auto& body : moved) actions_.push_back({Action::command, command(arm_, "disconnect", body)});
+    } else {
+      actions_.push_back({Action::await_delivery, {{"command_id", fetches[k]}}});
+      const double height = at(station_, product_.product.parts()[step.part].final_pose).translation().y();
+      standing = with_translation(start, dock[0], height, dock[2]);
+    }
+    // Carried up from where it stands, over to where the trajectory starts, then along it.
+    Data take = command(arm_, "grip", bodies[k]);
+    take["path"] = pose_numbers({standing * grip});
     take["opening"] = t.grasp.opening;
+    take["carried"] = fb::join_names({moved.begin() + 1, moved.end()});
     actions_.push_back({Action::command, take});
     std::vector<Pose> holding, retreat;
-    for (const Pose& p : part_path) holding.push_back(p * grip);
-    for (std::size_t k = 1; k < w.size(); ++k) (w[k].holding ? holding : retreat).push_back(at(station_, w[k].gripper));
-    add_arm_moves(body, holding, retreat);
+    const double least = above_asides(step, w.front().part) + places_.at(station_).position[1];
+    for (const Pose& p : lift_over(standing, start, least)) holding.push_back(p * grip);
+    for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(station_, w[i].gripper));
+    add_arm_moves(moved, holding, retreat, unit && !inserts_unit(step) ? unit->name : "");
   }
   next_action();
 }
@@ -719,7 +853,7 @@ void OrderOrchestrator::next_action() {
     if (step_ < plan_.steps.size()) {
       plan_.steps[step_].trajectory = candidates(step_)[candidate_];
       status("VIRTUAL_ASSEMBLY", "virtual assembly: " + std::to_string(step_ + 1) + " of " +
-                                     std::to_string(plan_.steps.size()) + " parts",
+                                     std::to_string(plan_.steps.size()) + " steps",
              double(step_ + 1) / plan_.steps.size());
       candidate_ = 0;
       if (++step_ < plan_.steps.size()) {
@@ -745,14 +879,14 @@ void OrderOrchestrator::action_done() {
   // Released, the part stands in the product: the durable state says so at once. Recorded
   // only at the connect after the gripper backed out, a twin that died in between left the
   // part "at the dock" for the next one, which inserted it again.
-  if (state() == "PHYSICAL" && a.kind == Action::command && get<std::string>(a.data, "operation") == "release") {
-    emit("PLACED", {{"part", get<std::string>(a.data, "part")}});
-    const std::size_t left = std::count_if(actions_.begin(), actions_.end(), [](const Action& x) {
-      return x.kind == Action::await_delivery;
-    });
+  const auto placed = a.kind == Action::command ? placed_by_.find(get<std::string>(a.data, "command_id")) : placed_by_.end();
+  if (state() == "PHYSICAL" && placed != placed_by_.end()) {
+    emit("PLACED", placed->second);
+    placed_by_.erase(placed);
+    const std::size_t left = placed_by_.size();
     status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ + ": " +
                                     std::to_string(plan_.steps.size() - left) + " of " +
-                                    std::to_string(plan_.steps.size()) + " parts",
+                                    std::to_string(plan_.steps.size()) + " steps",
            double(plan_.steps.size() - left) / plan_.steps.size());
   }
   actions_.pop_front();
@@ -816,7 +950,7 @@ void OrderOrchestrator::finish() {
   if (settings_.quote_only) {
     // Not feasible here is the quote's answer, which its caller gives.
   } else if (error_.empty()) {
-    status("DONE", "assembled " + std::to_string(plan_.steps.size()) + " parts at " + station_, 1);
+    status("DONE", "assembled " + std::to_string(product_.product.parts().size()) + " parts at " + station_, 1);
   } else {
     status("FAILED", error_, 0);
   }

@@ -23,7 +23,11 @@
 //   PHYSICAL     every part spawned at its buffer's dock; the hired robot's fetches in
 //                planned order; for each step the arm waits for that part's delivery, grips
 //                it at the station's dock, carries it up and over to its trajectory,
-//                inserts, releases, backs out, connects
+//                inserts, releases, backs out, connects. A subassembly's parts are built so
+//                on the station beside the product (its `aside`); the step inserting it
+//                makes them movable, grips its base with the others carried, lifts it up
+//                and over to its trajectory, inserts, releases, backs out, connects them all.
+//                Virtual assembly does the same in the order's scene.
 //   CLEANUP      the order's bodies leave cell-sim (the product leaves the station), then
 //   ENDED        everything released; FINISHED
 // An order for a quote (OrderSettings::quote_only) goes from VIRTUAL to
@@ -47,7 +51,8 @@
 //            robot_wait: s of their queues; fetch: s per part in planned order, arm: s per
 //            step), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
-//            FINDING (kind, message, part), PLACED (part: its body, assembled in place),
+//            FINDING (kind, message, part), PLACED (part: the bodies released in place,
+//            aside: the subassembly they were built into aside, "" in the product),
 //            FINISHED (complete, error, take_up: ended for the next twin to take the order up)
 
 #include <chrono>
@@ -83,6 +88,7 @@ struct OrderSettings {
     int attempt = 1;                  // this twin's, for command ids of its own
     std::string station;              // where its parts stand ("": nowhere)
     std::set<std::string> placed;     // bodies assembled at their final poses
+    std::set<std::string> aside;      // bodies built into a subassembly that stands aside
     std::set<std::string> delivered;  // bodies at the station's dock, not assembled yet
     std::set<std::string> used;       // every body handed out before: a part set aside needs a new one
   } resume;
@@ -149,7 +155,11 @@ class OrderOrchestrator : public fb::BasicBlock {
   void add_candidate(std::size_t step, std::size_t candidate);
   void plan_physical();
   void plan_cleanup();
-  void add_arm_moves(const std::string& body, const std::vector<Pose>& holding, const std::vector<Pose>& retreat);
+  void add_unit_candidate(std::size_t step, const Trajectory& t);
+  // `bodies`: the gripped one first, then those it carries; `aside`: the subassembly they are
+  // built into aside, "" when they go into the product.
+  void add_arm_moves(const std::vector<std::string>& bodies, const std::vector<Pose>& holding,
+                     const std::vector<Pose>& retreat, const std::string& aside);
   fb::Data command(const std::string& resource, const std::string& operation, const std::string& part = "");
   // Running them.
   void next_action();
@@ -168,6 +178,13 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::string virtual_body(PartIndex part) const;
   std::vector<std::string> virtual_gripper() const;  // its bodies in the order's scene, the palm first
   std::string physical_body(PartIndex part) const;
+  // The subassembly that `step` builds aside or inserts; nullptr for a single part's step.
+  const SubassemblyPlan* subassembly_of(const PlanStep& step) const;
+  // The least height (product frame) at which `step`'s part, at `pose` turned, and what it
+  // carries clear every subassembly built aside; -inf when there is none.
+  double above_asides(const PlanStep& step, const Pose& pose) const;
+  // Where `part` stands in its subassembly built aside, in the product's frame.
+  Pose aside_pose(PartIndex part, const SubassemblyPlan& unit) const;
   std::map<std::string, int> parts_per_type() const;
   bool waited_too_long() const;
 
@@ -201,6 +218,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   };
   std::map<std::string, Sent> unheard_;  // commands sent that no event has answered yet
   std::map<std::string, PartIndex> fetch_of_;
+  std::map<std::string, fb::Data> placed_by_;     // release command id -> the PLACED it makes true
   Timeline timeline_;
   std::map<std::string, std::size_t> timeline_index_;  // command id -> its entry
   void record(const fb::Data& event);  // a command event: when its command ran

@@ -145,16 +145,6 @@ class TwinProcess {
       write_plan(product, plan, plan_file);
       return end_with(1, why, plan_file.string());
     }
-    if (!plan.subassemblies.empty()) {
-      // Building one aside and inserting it whole needs cell-sim and the arm to carry several
-      // parts as one body: not there yet. The designer still gets the plan.
-      std::string names;
-      for (const auto& s : plan.subassemblies) names += (names.empty() ? "" : ", ") + s.name;
-      const std::string why = "the plan builds subassemblies (" + names + "), which this cell does not assemble yet";
-      if (options_.quote) return end_quote(product, twin::infeasible_quote(why, options_.rates), plan);
-      write_plan(product, plan, plan_file);
-      return end_with(1, why + "; see the plan", plan_file.string());
-    }
     return orchestrate(product, plan, plan_file);
   }
 
@@ -224,7 +214,7 @@ class TwinProcess {
         store_->set_aside(options_.order, p.part);
         store_->journal("twin-" + options_.order, "inspection", options_.order, p.part + " was in " + p.holder + "'s gripper");
       }
-      if (p.place == state::Place::placed) resume_.placed.insert(p.part);
+      if (p.place == state::Place::placed) (p.holder.empty() ? resume_.placed : resume_.aside).insert(p.part);
       if (p.place == state::Place::on_station) resume_.delivered.insert(p.part);
       if (p.place == state::Place::placed || p.place == state::Place::on_station || p.place == state::Place::in_gripper) {
         resume_.station = p.station;
@@ -365,7 +355,7 @@ class TwinProcess {
     }));
     r.connect("orchestrator", "FINDING", "findings", "REQ");
     r.add(std::make_unique<fb::ActionBlock>("placed", [this](const fb::Data& d) {
-      if (store_) store_->place(options_.order, fb::get<std::string>(d, "part"));
+      if (store_) store_->place(options_.order, fb::split_names(fb::get<std::string>(d, "part")), fb::get<std::string>(d, "aside"));
     }));
     r.connect("orchestrator", "PLACED", "placed", "REQ");
     std::optional<twin::Quote> quote;

@@ -8,19 +8,6 @@ namespace {
 
 constexpr double kAsideGap = 0.05;  // m between the product and a subassembly built beside it
 
-Eigen::AlignedBox3d final_bounds(const LoadedProduct& product, const std::vector<PartIndex>& parts) {
-  Eigen::AlignedBox3d box;
-  for (PartIndex p : parts) {
-    const Pose& pose = product.product.parts()[p].final_pose;
-    if (const auto& mesh = product.meshes[p]) {
-      for (const auto& v : mesh->vertices) box.extend(pose * v);
-    } else {
-      box.extend(pose.translation());
-    }
-  }
-  return box;
-}
-
 Product empty_like(const Product& product, const std::string& name) {
   Product out(name, product.source());
   for (const auto& [type, part_type] : product.types()) {
@@ -135,6 +122,20 @@ void add_plan(Plan& into, Plan from, const std::string& prefix) {
 }
 
 }  // namespace
+
+Eigen::AlignedBox3d final_bounds(const LoadedProduct& product, const std::vector<PartIndex>& parts) {
+  Eigen::AlignedBox3d box;
+  for (PartIndex p : parts) {
+    const Pose& pose = product.product.parts()[p].final_pose;
+    if (const auto& mesh = product.meshes[p]) {
+      for (const auto& v : mesh->vertices) box.extend(pose * v);
+    } else {
+      box.extend(pose.translation());
+    }
+  }
+  return box;
+}
+
 
 std::vector<Subassembly> subassemblies_of(const Product& product) {
   std::vector<Subassembly> out;

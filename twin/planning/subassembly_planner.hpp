@@ -17,6 +17,9 @@ struct Subassembly {
   std::vector<PartIndex> members;  // in the product's order; the first is its base
 };
 
+// The box of `parts` at their final poses, in the product's frame.
+Eigen::AlignedBox3d final_bounds(const LoadedProduct& product, const std::vector<PartIndex>& parts);
+
 // In the order their first parts come in the product.
 std::vector<Subassembly> subassemblies_of(const Product& product);
 
