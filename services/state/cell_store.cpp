@@ -296,12 +296,13 @@ std::map<std::string, std::map<std::string, int>> CellStore::kept(const std::str
 }
 
 void CellStore::move_parts(const std::string& order, const std::vector<std::string>& parts, Place to,
-                           const std::string& holder, const char* from, const char* or_from) {
+                           const std::string& holder, const char* from, bool or_placed_aside) {
   Transaction t(*this);
   std::vector<std::string> elsewhere;
   for (const std::string& part : parts) {
-    Statement(db_, "UPDATE parts SET place = ?, holder = ? WHERE order_id = ? AND part = ? AND place IN (?, ?)")
-        .bind(place_name(to), holder, order, part, from, or_from ? or_from : from)
+    Statement(db_, "UPDATE parts SET place = ?, holder = ? WHERE order_id = ? AND part = ? AND "
+                   "(place = ? OR (? AND place = 'placed' AND holder <> ''))")
+        .bind(place_name(to), holder, order, part, from, or_placed_aside ? 1 : 0)
         .step();
     if (sqlite3_changes(db_) != 1) elsewhere.push_back(part);
   }
@@ -309,7 +310,8 @@ void CellStore::move_parts(const std::string& order, const std::vector<std::stri
   // A part that was not where this move starts (handed out before the cell kept state, or
   // moved by a process that was killed before it could say so): the journal tells.
   for (const std::string& part : elsewhere) {
-    journal(holder, std::string("unexpected ") + place_name(to), order, part + " was not " + from);
+    journal(holder, std::string("unexpected ") + place_name(to), order,
+            part + " was not " + from + (or_placed_aside ? " or in a subassembly aside" : ""));
   }
 }
 
@@ -326,7 +328,7 @@ void CellStore::deliver(const std::string& order, const std::string& part, const
 
 void CellStore::grip(const std::string& order, const std::vector<std::string>& parts, const std::string& arm) {
   // At the dock, or placed in a subassembly built aside that the arm now carries whole.
-  move_parts(order, parts, Place::in_gripper, arm, "on_station", "placed");
+  move_parts(order, parts, Place::in_gripper, arm, "on_station", true);
 }
 
 void CellStore::release(const std::string& order, const std::vector<std::string>& parts) {

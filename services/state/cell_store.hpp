@@ -170,9 +170,10 @@ class CellStore {
   // The part, on its way, goes back to the buffer it came from (within a transaction).
   void put_back(const PartRecord& part);
   std::vector<PartRecord> parts_held(const std::string& holder, Place place) const;
-  // In one transaction: each part that is `from` (or `or_from`) goes `to`.
+  // In one transaction: each part that is `from` (or placed into a subassembly aside, with
+  // `or_placed_aside`) goes `to`.
   void move_parts(const std::string& order, const std::vector<std::string>& parts, Place to, const std::string& holder,
-                  const char* from, const char* or_from = nullptr);
+                  const char* from, bool or_placed_aside = false);
   sqlite3* db_ = nullptr;
 };
 

@@ -7,7 +7,9 @@
 
 namespace fb {
 namespace {
-constexpr std::size_t kMaxCarried = 64;  // a subassembly's members: far more than any has
+// A subassembly's members: cell-sim moves at most 64 bodies with one, and the arm's palm
+// carries its fingers, its carriage and the gripped part besides.
+constexpr std::size_t kMaxCarried = 60;
 }  // namespace
 
 ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
@@ -89,10 +91,15 @@ void ArmBlock::check(const Data& command, SampleCheck& c) const {
     why << "opening: " << opening << " m is wider than the gripper opens (" << settings_.gripper.max_opening << " m)";
     c.require(!(opening > settings_.gripper.max_opening), why.str());
     c.names("carried", kMaxCarried);
+    if (!c.ok()) return;
     const auto carried = split_names(get_or<std::string>(command, "carried", ""));
-    const std::set<std::string> distinct(carried.begin(), carried.end());
-    c.require(distinct.size() == carried.size() && !distinct.count(get<std::string>(command, "part")),
-              "carried: names a body twice, or the gripped part");
+    const std::string part = get_or<std::string>(command, "part", "");
+    std::set<std::string> distinct(carried.begin(), carried.end());
+    c.require(distinct.size() == carried.size() && !distinct.count(part), "carried: names a body twice, or the gripped part");
+    c.require(carried.empty() || !part.empty(), "carried: bodies carried with no part gripped");
+    for (const auto& body : gripper_bodies()) {
+      c.require(!distinct.count(body), "carried: " + body + " is the arm's own");
+    }
   } else if (operation == "translate" || operation == "rotate") {
     c.poses("path", 1);
   } else if (operation == "connect" || operation == "disconnect") {

@@ -58,6 +58,33 @@ TEST_CASE("arm: a grip places palm, fingers and carriage, a second grip replaces
   CHECK(f.block().held() == "o1/B1");
 }
 
+TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part until the release", "[fb][arm]") {
+  fb::BlockTestFixture<fb::ArmBlock> f("arm", "arm-1", fb::ArmSettings{});
+  const fb::Data grasp{{"part", std::string("o1/base")}, {"carried", fb::join_names({"o1/m1", "o1/m2"})},
+                       {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
+  REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("g", "grip", grasp))) == Names{"ACCEPT"});
+  const auto spawns = f.send("START", {{"command_id", std::string("g")}});
+  for (const auto& request : spawns) f.send("SIM_REPLY", reply_to(request));
+  CHECK(f.block().carried() == std::vector<std::string>{"o1/m1", "o1/m2"});
+  const auto move_of = [&](const std::string& id) {
+    REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command(id, "translate", {{"path", fb::Numbers{0, 0.2, 0, 1, 0, 0, 0}}}))) ==
+            Names{"ACCEPT"});
+    const auto out = f.send("START", {{"command_id", id}});
+    REQUIRE(out.size() == 1);
+    const auto carried = fb::split_names(fb::get<std::string>(out[0].data, "carried"));
+    f.send("SIM_REPLY", reply_to(out[0]));
+    return carried;
+  };
+  const auto holding = move_of("t1");
+  for (const char* body : {"o1/base", "o1/m1", "o1/m2"}) CHECK(std::count(holding.begin(), holding.end(), body) == 1);
+  REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("r", "release", {}))) == Names{"ACCEPT"});
+  f.send("START", {{"command_id", std::string("r")}});
+  CHECK(f.block().carried().empty());
+  const auto after = move_of("t2");
+  CHECK(std::count(after.begin(), after.end(), "o1/m1") == 0);
+  CHECK(std::count(after.begin(), after.end(), "o1/base") == 0);
+}
+
 TEST_CASE("mobile robot: drive to the buffer, ask it, drive to the station carrying the part", "[fb][mobile-robot]") {
   fb::BlockTestFixture<fb::MobileRobotBlock> f("robot", "robot-1", fb::Numbers{1, 0, 1}, 0.5);
   const auto spawn = f.send("INIT");
@@ -274,8 +301,19 @@ TEST_CASE("device: a malformed command is refused with the field, never started"
   CHECK(arm_refusal(f, "grip", with(kGrasp, "opening", nan)) == "opening: nan is not finite");
   CHECK(arm_refusal(f, "grip", with(kGrasp, "opening", 0.5)) == "opening: 0.5 m is wider than the gripper opens (0.2 m)");
   CHECK(arm_refusal(f, "grip", with(kGrasp, "part", std::string(300, 'x'))) == "part: 300 characters, more than 255");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "carried", std::string("o1/B2"))).empty());  // a subassembly's member
+  std::vector<std::string> many;
+  for (int i = 0; i < 61; ++i) many.push_back("o1/M" + std::to_string(i));
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "carried", fb::join_names(many))) == "carried: 61 names, more than 60");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "carried", fb::join_names({"o1/B2", "o1/B2"}))) ==
+        "carried: names a body twice, or the gripped part");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "carried", std::string("o1/B1"))) ==
+        "carried: names a body twice, or the gripped part");
+  CHECK(arm_refusal(f, "grip", with(kGrasp, "carried", std::string("arm-1/palm"))) == "carried: arm-1/palm is the arm's own");
+  CHECK(arm_refusal(f, "grip", with(with(kGrasp, "part", std::string()), "carried", std::string("o1/B2"))) ==
+        "carried: bodies carried with no part gripped");
   CHECK(arm_refusal(f, "grip", with(kGrasp, "sim_time", nan)) == "sim_time: nan is not finite");
-  CHECK(f.block().refused() == 12);
+  CHECK(f.block().refused() == 17);
   CHECK(f.block().last_refusal().find("sim_time: nan is not finite") != std::string::npos);
   // A refused command was never taken: starting it finds nothing.
   CHECK(fb::get<std::string>(f.send("START", {{"command_id", std::string("c3")}})[0].data, "reason") == "unknown command");

@@ -119,6 +119,53 @@ TEST_CASE("a part moves buffer, robot, station, gripper, product, and is counted
   }
 }
 
+TEST_CASE("a subassembly: its parts stand aside under its name, move to the gripper and back together", "[state]") {
+  state::CellStore store(fresh_dir("subassembly"));
+  store.open_buffer("buffer-1", {{"Shaft", 1}, {"Pendulum", 1}, {"Plate", 1}});
+  for (const auto& [type, part] : {std::pair{"Shaft", "o1/shaft"}, {"Pendulum", "o1/pendulum"}, {"Plate", "o1/plate"}}) {
+    store.give("buffer-1", type, "o1", part, "robot-1");
+    store.deliver("o1", part, "station-1");
+  }
+  const auto where = [&](const std::string& part) {
+    for (const auto& p : store.parts("o1")) {
+      if (p.part == part) return std::pair{p.place, p.holder};
+    }
+    return std::pair{state::Place::returned, std::string("none")};
+  };
+  // Built aside: placed, held by the subassembly's name.
+  for (const char* part : {"o1/shaft", "o1/pendulum"}) {
+    store.grip("o1", {part}, "arm-1");
+    store.release("o1", {part});
+    store.place("o1", {part}, "ShaftPendulum");
+    CHECK(where(part) == std::pair{state::Place::placed, std::string("ShaftPendulum")});
+  }
+  store.grip("o1", {"o1/plate"}, "arm-1");
+  store.release("o1", {"o1/plate"});
+  store.place("o1", {"o1/plate"});
+  // A part standing in the product is not gripped again (the journal says so).
+  store.grip("o1", {"o1/plate"}, "arm-1");
+  CHECK(where("o1/plate") == std::pair{state::Place::placed, std::string()});
+  CHECK(store.count_events("arm-1", "unexpected in_gripper") == 1);
+  // The subassembly gripped by its base, the other carried: both in the gripper at once.
+  store.grip("o1", {"o1/shaft", "o1/pendulum"}, "arm-1");
+  CHECK(where("o1/shaft") == std::pair{state::Place::in_gripper, std::string("arm-1")});
+  CHECK(where("o1/pendulum") == std::pair{state::Place::in_gripper, std::string("arm-1")});
+  require_conserved(store);
+  SECTION("inserted: released and placed in the product together") {
+    store.release("o1", {"o1/shaft", "o1/pendulum"});
+    store.place("o1", {"o1/shaft", "o1/pendulum"});
+    CHECK(where("o1/pendulum") == std::pair{state::Place::placed, std::string()});
+    store.assemble("o1");
+    CHECK(store.inventory().at("Pendulum").assembled == 1);
+  }
+  SECTION("the arm restarts under it: the whole subassembly goes to inspection") {
+    CHECK(store.hold_for_inspection("arm-1").size() == 2);
+    CHECK(store.inventory().at("Shaft").inspection == 1);
+    CHECK(store.inventory().at("Pendulum").inspection == 1);
+  }
+  require_conserved(store);
+}
+
 TEST_CASE("the commands a resource had taken on are answered once by the process after it", "[state]") {
   state::CellStore store(fresh_dir("commands"));
   store.command_taken({"robot-1", "o1/c1", "o1", "fetch", "o1/peg"});

@@ -358,7 +358,7 @@ void OrderOrchestrator::call_robot_when_ready(const char* how) {
   robot_called_ = true;
   std::vector<std::string> sources;
   for (const auto& step : plan_.steps) {
-    sources.push_back(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
+    if (!inserts_unit(step)) sources.push_back(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
   }
   emit(how, call_data(kRobot, "fetch", "", station_, fb::join_names(sources), static_cast<long>(sources.size()), 0));
 }
@@ -618,7 +618,8 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
   const auto all = candidates(step_);
   const std::string& name = product_.product.parts()[part].name;
   emit("FINDING", {{"kind", std::string("collision")},
-                   {"message", name + " along '" + all[candidate_].label + "' in cell-sim: " + reason},
+                   {"message", step_name(product_.product, plan_.steps[step_]) + " along '" + all[candidate_].label +
+                                   "' in cell-sim: " + reason},
                    {"part", name}});
   actions_.clear();
   action_running_ = false;
@@ -710,6 +711,7 @@ void OrderOrchestrator::plan_physical() {
   status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ +
                                   (resume.used.empty() ? "" : " (taken up again: " + std::to_string(resume.placed.size()) +
                                                                   " parts in place, " +
+                                                                  (resume.aside.empty() ? "" : std::to_string(resume.aside.size()) + " built aside, ") +
                                                                   std::to_string(resume.delivered.size()) + " at the dock)"),
          0);
   const Numbers& dock = places_.at(station_).dock;
@@ -739,10 +741,13 @@ void OrderOrchestrator::plan_physical() {
     const std::string mesh = part.mesh->file.string();
     const double scale = part.mesh->scale;
     const std::string* placed = body_in(resume.placed, body);  // done: it stands in the product
-    const std::string* aside = body_in(resume.aside, body);    // done: it stands in its subassembly aside
+    const SubassemblyPlan* unit = subassembly_of(step);
+    // Done: it stands in its subassembly aside (a state that says so of a part this plan
+    // builds into none is not taken: the part is fetched anew).
+    const std::string* aside = unit ? body_in(resume.aside, body) : nullptr;
     if (placed || aside) {
       body = placed ? *placed : *aside;
-      const Pose where = placed ? final_pose : at(station_, aside_pose(step.part, *subassembly_of(step)));
+      const Pose where = placed ? final_pose : at(station_, aside_pose(step.part, *unit));
       actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({where}), {0, 0, 0}, true, mesh, "", scale)});
       spawned_.insert(body);
       body_of[step.part] = body;

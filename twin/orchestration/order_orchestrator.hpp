@@ -48,7 +48,7 @@
 //           UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
 //           order_id, state, reason, sim_time), SIM_REPLY (request_id, ok, error, collided, ...)
 //   outputs: CALL and ASK (to the Negotiator), QUOTE (station, station_wait, robot,
-//            robot_wait: s of their queues; fetch: s per part in planned order, arm: s per
+//            robot_wait: s of their queues; fetch: s per step (0 for a subassembly's insertion), arm: s per
 //            step), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: the bodies released in place,
@@ -147,7 +147,7 @@ class OrderOrchestrator : public fb::BasicBlock {
   void on_quoted(const fb::Data& quote);
   void quote_when_arm_known();
   static double queue_of(const fb::Data& quoted);
-  std::vector<double> fetch_times() const;  // s per part in planned order: the robot's bid, shared by distance
+  std::vector<double> fetch_times() const;  // s per step: the robot's bid, shared by distance (0: it fetches nothing)
   fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
                      const std::string& station, const std::string& sources, long count, double duration) const;
   void start_physical_when_hired();

@@ -18,7 +18,7 @@ struct QuoteBids {
   std::string station, robot;
   double station_wait = 0;  // the station's bid: the orders in its queue, from now
   double robot_wait = 0;    // the robot's bid: the fetches it has taken on, from now
-  std::vector<double> fetch;  // each part's fetch, in planned order
+  std::vector<double> fetch;  // each step's fetch, in planned order (0: it fetches nothing)
   std::vector<double> arm;    // the arm's time for each step: from the dock, in, back
 };
 

@@ -221,8 +221,9 @@ class TwinProcess {
       }
     }
     store_->journal("twin-" + options_.order, "taken up", options_.order,
-                    std::to_string(resume_.placed.size()) + " parts in place and " +
-                        std::to_string(resume_.delivered.size()) + " at the dock of " + resume_.station);
+                    std::to_string(resume_.placed.size()) + " parts in place, " + std::to_string(resume_.aside.size()) +
+                        " built aside and " + std::to_string(resume_.delivered.size()) + " at the dock of " +
+                        resume_.station);
     return true;
   }
 
