@@ -34,6 +34,9 @@ CREATE TABLE IF NOT EXISTS orders(
   product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', sequence TEXT NOT NULL DEFAULT '',
   path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0,
   quote INTEGER NOT NULL DEFAULT 0);
+CREATE TABLE IF NOT EXISTS plan_steps(
+  order_id TEXT NOT NULL, position INTEGER NOT NULL, step TEXT NOT NULL, trajectory TEXT NOT NULL,
+  PRIMARY KEY(order_id, position));
 CREATE TABLE IF NOT EXISTS journal(
   seq INTEGER PRIMARY KEY AUTOINCREMENT, time REAL NOT NULL, source TEXT NOT NULL, event TEXT NOT NULL,
   order_id TEXT NOT NULL, detail TEXT NOT NULL);
@@ -517,6 +520,25 @@ std::vector<OrderRecord> CellStore::orders() const {
     out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(4), rows.text(5), rows.text(6),
                    static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8)), rows.integer(9) != 0});
   }
+  return out;
+}
+
+void CellStore::set_plan(const std::string& order, const std::vector<PlanStepRecord>& steps) {
+  Transaction t(*this);
+  Statement(db_, "DELETE FROM plan_steps WHERE order_id = ?").bind(order).step();
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    Statement(db_, "INSERT INTO plan_steps(order_id, position, step, trajectory) VALUES(?, ?, ?, ?)")
+        .bind(order, static_cast<long>(i), steps[i].step, steps[i].trajectory)
+        .step();
+  }
+  t.commit();
+}
+
+std::vector<PlanStepRecord> CellStore::plan_of(const std::string& order) const {
+  Statement rows(db_, "SELECT step, trajectory FROM plan_steps WHERE order_id = ? ORDER BY position");
+  rows.bind(order);
+  std::vector<PlanStepRecord> out;
+  while (rows.step()) out.push_back({rows.text(0), rows.text(1)});
   return out;
 }
 

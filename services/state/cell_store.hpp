@@ -68,6 +68,13 @@ struct OrderRecord {
   bool ended() const;  // DONE or FAILED
 };
 
+// A step of the plan an order's physical assembly follows: what it puts in (a part's name,
+// or a subassembly's for the step inserting it) and the trajectory virtual assembly took.
+struct PlanStepRecord {
+  std::string step, trajectory;
+  bool operator==(const PlanStepRecord& o) const { return step == o.step && trajectory == o.trajectory; }
+};
+
 struct JournalEntry {
   long seq = 0;
   double time = 0;  // Unix time, s
@@ -150,6 +157,9 @@ class CellStore {
   // One more twin started for the order; the attempts so far.
   int count_attempt(const std::string& order);
   std::vector<OrderRecord> orders() const;
+  // Stored when physical assembly begins, so that a twin taking the order up follows it.
+  void set_plan(const std::string& order, const std::vector<PlanStepRecord>& steps);
+  std::vector<PlanStepRecord> plan_of(const std::string& order) const;
   // An order of the cell's desk that has not ended: when its twin dies, the cell starts
   // another, so what the order booked and built waits for it.
   bool awaits_twin(const std::string& order) const;

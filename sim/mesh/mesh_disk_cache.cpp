@@ -7,8 +7,12 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <stdexcept>
 #include <sstream>
 #include <unistd.h>
+
+#include <openssl/evp.h>
 
 namespace sim {
 namespace {
@@ -17,10 +21,23 @@ constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
 constexpr std::uint32_t kVersion = 5;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept
 
-// FNV-1a, 64 bits: stable across runs and builds, which std::hash is not.
-std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665603ULL) {
-  for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ULL;
-  return h;
+// SHA-256 of the file's bytes, then its extension (how it is read), in hex. Meshes come from
+// OEMs (the order desk): with a hash one can collide on purpose (FNV-1a was used before), a
+// crafted file could stand in for another client's cached mesh.
+std::string content_hash(const std::string& bytes, const std::string& extension) {
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context(EVP_MD_CTX_new(), EVP_MD_CTX_free);
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1 ||
+      EVP_DigestUpdate(context.get(), bytes.data(), bytes.size()) != 1 ||
+      EVP_DigestUpdate(context.get(), extension.data(), extension.size()) != 1 ||
+      EVP_DigestFinal_ex(context.get(), digest, &length) != 1) {
+    throw std::runtime_error("SHA-256 failed");
+  }
+  static const char* const hex = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < length; ++i) out += {hex[digest[i] >> 4], hex[digest[i] & 15]};
+  return out;
 }
 
 template <class T>
@@ -157,7 +174,11 @@ std::shared_ptr<const TriangleMesh> MeshDiskCache::load(const std::filesystem::p
   std::string bytes(size, '\0');
   if (!in.read(bytes.data(), static_cast<std::streamsize>(size))) return load_mesh(file, scale);
   std::ostringstream name;
-  name << std::hex << fnv1a(file.extension().string(), fnv1a(bytes)) << '-' << std::hexfloat << scale;
+  try {
+    name << content_hash(bytes, file.extension().string()) << '-' << std::hexfloat << scale;
+  } catch (const std::exception&) {
+    return load_mesh(file, scale);  // no entry without its hash
+  }
   std::string entry_name = name.str();
   for (char& c : entry_name) {
     if (c == '+' || c == '.') c = '_';

@@ -1,5 +1,5 @@
 #pragma once
-// Loaded meshes on disk, by the hash of the file's bytes and the scale: a second order of
+// Loaded meshes on disk, by the SHA-256 of the file's bytes and the scale: a second order of
 // the same product (another twin process, another `cellctl plan`) reads the repaired mesh
 // back instead of parsing the CAD export again. Entries are written whole (a temporary file
 // renamed into place); one that is short, of another version or inconsistent is ignored and

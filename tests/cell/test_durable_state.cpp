@@ -153,9 +153,14 @@ void check_taken_up(const fs::path& state_dir, const std::string& order, const s
     CHECK(assembled.count(part) == 1);
     CHECK(all.count(part + "/r2") == 0);
   }
-  bool taken_up = false;
-  for (const auto& e : store.journal_since(0)) taken_up |= e.order == order && e.event == "taken up";
+  bool taken_up = false, plan_followed = false;
+  for (const auto& e : store.journal_since(0)) {
+    taken_up |= e.order == order && e.event == "taken up";
+    plan_followed |= e.order == order && e.event == "plan followed";  // the order its predecessor began
+  }
   CHECK(taken_up);
+  CHECK(plan_followed);
+  CHECK(store.plan_of(order).size() >= parts);
   for (const auto& [type, c] : store.inventory()) CHECK(c.initial == c.accounted());
 }
 

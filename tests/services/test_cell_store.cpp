@@ -166,6 +166,20 @@ TEST_CASE("a subassembly: its parts stand aside under its name, move to the grip
   require_conserved(store);
 }
 
+TEST_CASE("an order's plan is stored whole and replaced whole, and kept across a reopening", "[state]") {
+  const auto dir = fresh_dir("plan");
+  {
+    state::CellStore store(dir);
+    CHECK(store.plan_of("o1").empty());
+    store.set_plan("o1", {{"back", "down"}, {"shaft", "down"}, {"ShaftPendulum", "down"}});
+    store.set_plan("o2", {{"b1", "down"}});
+    store.set_plan("o1", {{"back", "down"}, {"shaft", "from +x"}});
+  }
+  state::CellStore again(dir);
+  CHECK(again.plan_of("o1") == std::vector<state::PlanStepRecord>{{"back", "down"}, {"shaft", "from +x"}});
+  CHECK(again.plan_of("o2") == std::vector<state::PlanStepRecord>{{"b1", "down"}});
+}
+
 TEST_CASE("the commands a resource had taken on are answered once by the process after it", "[state]") {
   state::CellStore store(fresh_dir("commands"));
   store.command_taken({"robot-1", "o1/c1", "o1", "fetch", "o1/peg"});

@@ -1,5 +1,6 @@
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -160,6 +161,23 @@ TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores
     f.write(reinterpret_cast<const char*>(&far), sizeof far);
   }
   same(*sim::MeshDiskCache(folder).load(file, 1e-3));
+  // Entries are named by the SHA-256 of the content (64 hex digits), not by a hash one can
+  // collide on purpose: meshes come from OEMs.
+  CHECK(std::regex_match(entry.filename().string(), std::regex("[0-9a-f]{64}-.*\\.mesh")));
+  std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("the cache in memory: a second ask for a mesh is the same mesh, not loaded again", "[mesh][cache]") {
+  const auto folder = std::filesystem::temp_directory_path() / ("mesh-memory-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(folder);
+  sim::MeshCache cache(folder);
+  const auto file = data("planning/messy/meshes/flipped_block_mm.obj");
+  const auto first = cache.get(file, 1e-3);
+  std::filesystem::remove_all(folder);  // nothing on disk: a second load would have to parse the file again
+  CHECK(cache.get(file, 1e-3) == first);
+  CHECK(cache.size() == 1);
+  CHECK(cache.get(file, 1.0) != first);  // another scale, another mesh
+  CHECK(cache.size() == 2);
   std::filesystem::remove_all(folder);
 }
 

@@ -283,6 +283,23 @@ TEST_CASE("orchestrator: a subassembly is built aside, then gripped by its base 
   CHECK(inserted == members);
 }
 
+TEST_CASE("orchestrator: a subassembly that finds no way in cell-sim fails the order, every try said", "[twin][orchestration][subassembly]") {
+  const test::Planned nested(std::filesystem::path(TEST_DATA_DIR) / "planning/cranfield-subassembly/cranfield-subassembly.aml");
+  REQUIRE(nested.plan.complete);
+  const auto unit = std::find_if(nested.plan.steps.begin(), nested.plan.steps.end(), [](const auto& s) { return !s.carried.empty(); });
+  REQUIRE(unit != nested.plan.steps.end());
+  Twin t(nested.product, nested.plan);
+  Cell cell;  // every move of the whole subassembly collides
+  cell.collide = [](const Data& move, long) { return carries(move, "o1/virtual/shaft") && carries(move, "o1/virtual/pendulum"); };
+  const Outcome out = run(t, cell);
+  CHECK(out.finished);
+  CHECK_FALSE(out.complete);
+  CHECK(out.error.find("no collision-free path in cell-sim for ShaftPendulum (shaft, pendulum)") != std::string::npos);
+  CHECK(out.error.find("not planned again") != std::string::npos);
+  CHECK(std::count(out.findings.begin(), out.findings.end(), "collision") == static_cast<long>(unit->failed.size() + 1));
+  CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") == out.order.end());  // never booked a station
+}
+
 TEST_CASE("orchestrator: a queued order says how many are ahead, and goes on when the station is its", "[twin][orchestration]") {
   const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
   Twin t(lego.product, lego.plan);

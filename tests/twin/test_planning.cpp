@@ -132,6 +132,29 @@ TEST_CASE("the same input gives the same plan", "[planning][determinism]") {
   CHECK(first.findings.size() == second.findings.size());
 }
 
+TEST_CASE("a given order (a twin taking an order up) is followed, and one that cannot be built is not", "[planning][given]") {
+  sim::MeshCache cache;
+  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  const twin::Plan searched = plan(test::product("cranfield/cranfield.aml"), "search", cache, loaded);
+  REQUIRE(searched.complete);
+  std::vector<std::string> given = order(loaded, searched);
+  // The links leave the bolts' order open: another order that works.
+  std::swap(given[at(given, "boltA1")], given[at(given, "boltR2")]);
+  const auto path = twin::make_path_planner("linear");
+  twin::GivenSequencePlanner followed(given);
+  const twin::Plan p = twin::plan_assembly(loaded, followed, *path);
+  CHECK(p.complete);
+  CHECK(order(loaded, p) == given);
+  // The front plate second closes the product: the bolts cannot go in after it.
+  std::vector<std::string> front_early = given;
+  front_early.erase(front_early.begin() + at(front_early, "front"));
+  front_early.insert(front_early.begin() + 1, "front");
+  twin::GivenSequencePlanner wrong(front_early);
+  const twin::Plan blocked = twin::plan_assembly(loaded, wrong, *path);
+  CHECK_FALSE(blocked.complete);
+  CHECK(blocked.steps.size() < given.size());
+}
+
 TEST_CASE("no straight insertion: OMPL's RRT-Connect finds a path, checked in the collision world", "[planning][ompl]") {
   sim::MeshCache cache;
   twin::LoadedProduct loaded{twin::Product("", ""), {}};

@@ -100,6 +100,48 @@ TEST_CASE("subassemblies: built aside first, then inserted as one body", "[plann
   CHECK(node->at("built_by")[0].at("part") == "shaft");
 }
 
+namespace {
+
+// The nested Cranfield with these precedence rules (before, after: part IDs) on its product.
+std::filesystem::path with_rules(const std::string& name, const std::vector<std::pair<std::string, std::string>>& rules) {
+  const std::string product = R"(<InternalElement Name="CranfieldBenchmark" ID="a846b535-fd6a-41f0-8689-a1a034adcca2">)";
+  std::string attribute = R"(<Attribute Name="AssemblyPrecedence">)";
+  for (std::size_t i = 0; i < rules.size(); ++i) {
+    attribute += R"(<Attribute Name="P)" + std::to_string(i) + R"("><Attribute Name="Before" AttributeDataType="xs:string"><Value>)" +
+                 rules[i].first + R"(</Value></Attribute><Attribute Name="After" AttributeDataType="xs:string"><Value>)" +
+                 rules[i].second + "</Value></Attribute></Attribute>";
+  }
+  return variant(name, product, product + attribute + "</Attribute>");
+}
+
+const char* const kBoltA1 = "d13c1326-a2d4-44e4-8a55-fdb122483b8c";
+const char* const kShaft = "26817d7b-e747-47e7-8759-d3d8dcd4025e";
+const char* const kPendulum = "39fa941f-cc2b-4f7f-88c2-bdb0b2801dee";
+
+}  // namespace
+
+TEST_CASE("subassemblies: a precedence with a subassembly's part holds for the whole, and one that cannot is a finding",
+          "[planning][subassembly]") {
+  SECTION("a bolt before the pendulum: the subassembly goes in after the bolt") {
+    const auto loaded = test::load(with_rules("bolt-first", {{kBoltA1, kPendulum}}));
+    const twin::Plan plan = plan_of(loaded);
+    REQUIRE(plan.complete);
+    const twin::PartIndex bolt = *loaded.product.find_part_by_name("boltA1");
+    const auto step_of = [&](auto&& is) { return std::find_if(plan.steps.begin(), plan.steps.end(), is) - plan.steps.begin(); };
+    CHECK(step_of([&](const twin::PlanStep& s) { return s.part == bolt; }) <
+          step_of([](const twin::PlanStep& s) { return !s.carried.empty(); }));
+  }
+  SECTION("the shaft before a bolt and the bolt before the pendulum: no whole insertion can keep both") {
+    const auto loaded = test::load(with_rules("both-ways", {{kShaft, kBoltA1}, {kBoltA1, kPendulum}}));
+    const twin::Plan plan = plan_of(loaded);
+    CHECK_FALSE(plan.complete);
+    CHECK(std::any_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) {
+      return f.kind == "infeasible" && f.message.find("cannot hold with each subassembly inserted whole") != std::string::npos &&
+             f.message.find("closes a cycle") != std::string::npos;
+    }));
+  }
+}
+
 TEST_CASE("subassemblies: the animation builds it aside and carries the pendulum in with the shaft", "[planning][subassembly][gltf]") {
   const auto loaded = test::load(test::data(kNested));
   const twin::Plan plan = plan_of(loaded);

@@ -38,6 +38,7 @@
 #include "twin/model/source_ref.hpp"
 #include "twin/orchestration/order_network.hpp"
 #include "twin/orchestration/quote.hpp"
+#include "twin/planning/sequence_planner.hpp"
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/html_report.hpp"
 #include "twin/report/plan_json.hpp"
@@ -131,11 +132,10 @@ class TwinProcess {
     }
     const twin::LoadedProduct& product = *loaded;
     status("PLANNING", "planning " + std::to_string(product.product.parts().size()) + " parts", 0);
-    auto sequence = twin::make_sequence_planner(options_.sequence);
     auto path = twin::make_path_planner(options_.path);
     twin::PlannerOptions planning;
     planning.gripper = options_.gripper;
-    twin::Plan plan = twin::plan_assembly(product, *sequence, *path, planning);
+    twin::Plan plan = plan_order(product, *path, planning);
     std::filesystem::create_directories(options_.out);
     const auto plan_file = std::filesystem::absolute(options_.out) / "plan.json";
     if (!plan.complete) {
@@ -149,6 +149,39 @@ class TwinProcess {
   }
 
  private:
+  // A twin taking up an order whose physical assembly had begun follows the order its
+  // predecessor stored (the parts in place were put in by it); where that no longer plans
+  // (another cell-sim, another build), it plans anew and the journal says so.
+  twin::Plan plan_order(const twin::LoadedProduct& product, twin::PathPlanner& path, const twin::PlannerOptions& options) {
+    const auto stored = store_ ? store_->plan_of(options_.order) : std::vector<state::PlanStepRecord>{};
+    if (!stored.empty()) {
+      std::vector<std::string> order;
+      for (const auto& s : stored) order.push_back(s.step);
+      twin::GivenSequencePlanner given(order);
+      twin::Plan plan = twin::plan_assembly(product, given, path, options);
+      if (plan.complete) {
+        store_->journal("twin-" + options_.order, "plan followed", options_.order,
+                        "the stored order of " + std::to_string(stored.size()) + " steps");
+        return plan;
+      }
+      store_->journal("twin-" + options_.order, "plan not followed", options_.order,
+                      "the stored order did not plan again: " +
+                          (plan.findings.empty() ? std::string("incomplete") : plan.findings.back().message));
+    }
+    const auto sequence = twin::make_sequence_planner(options_.sequence);
+    return twin::plan_assembly(product, *sequence, path, options);
+  }
+
+  // The plan physical assembly follows, as virtual assembly validated it.
+  void store_plan(const twin::LoadedProduct& product, const twin::Plan& plan) {
+    std::vector<state::PlanStepRecord> steps;
+    for (const auto& step : plan.steps) {
+      const std::string name = step.carried.empty() ? product.product.parts()[step.part].name : step.subassembly;
+      steps.push_back({name, step.trajectory.label});
+    }
+    store_->set_plan(options_.order, steps);
+  }
+
   // `reported`: the orchestrator has published FAILED already.
   int end_with(int code, const std::string& error, const std::string& plan_file = "", bool reported = false) {
     if (store_ && !running) {
@@ -344,8 +377,10 @@ class TwinProcess {
                                           << fb::get<std::string>(d, "kind") << " " << fb::get<std::string>(d, "body_id") << std::endl;
           return dds::to_sim_request(d);
         });
-    r.add(std::make_unique<fb::ActionBlock>("status", [this](const fb::Data& d) {
-      status(fb::get<std::string>(d, "state"), fb::get<std::string>(d, "message"), fb::get<double>(d, "progress"));
+    r.add(std::make_unique<fb::ActionBlock>("status", [this, &product, &orchestrator](const fb::Data& d) {
+      const std::string& state = fb::get<std::string>(d, "state");
+      if (store_ && state == "PHYSICAL_ASSEMBLY" && stored_state_ != state) store_plan(product, orchestrator.plan());
+      status(state, fb::get<std::string>(d, "message"), fb::get<double>(d, "progress"));
     }));
     r.connect("orchestrator", "STATUS", "status", "REQ");
     std::vector<twin::Finding> findings;

@@ -31,6 +31,16 @@ std::vector<PartIndex> SearchSequencePlanner::candidates(const AssemblyScene& sc
   return allowed;
 }
 
+std::vector<PartIndex> GivenSequencePlanner::candidates(const AssemblyScene& scene) const {
+  const auto& parts = scene.product().product.parts();
+  for (const std::string& name : order_) {
+    for (PartIndex p = 0; p < parts.size(); ++p) {
+      if (parts[p].name == name && !scene.is_assembled(p)) return {p};
+    }
+  }
+  return {};
+}
+
 std::unique_ptr<SequencePlanner> make_sequence_planner(const std::string& name) {
   if (name == "paper") return std::make_unique<PaperSequencePlanner>();
   if (name == "search") return std::make_unique<SearchSequencePlanner>();

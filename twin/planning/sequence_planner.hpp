@@ -40,6 +40,20 @@ class SearchSequencePlanner : public SequencePlanner {
   bool backtracks() const override { return true; }
 };
 
+// An order given by name (a part's, or a subassembly's where the scene holds it as one
+// body): the first of them not assembled yet. One candidate, no backtracking. A twin that
+// takes an order up plans again in the order its predecessor began to build.
+class GivenSequencePlanner : public SequencePlanner {
+ public:
+  explicit GivenSequencePlanner(std::vector<std::string> order) : order_(std::move(order)) {}
+  std::string name() const override { return "given"; }
+  std::vector<PartIndex> candidates(const AssemblyScene& scene) const override;
+  bool backtracks() const override { return false; }
+
+ private:
+  std::vector<std::string> order_;
+};
+
 std::unique_ptr<SequencePlanner> make_sequence_planner(const std::string& name);
 
 

@@ -3,6 +3,8 @@
 #include <cctype>
 #include <map>
 
+#include "twin/model/source_ref.hpp"
+
 namespace twin {
 namespace {
 
@@ -36,14 +38,23 @@ LoadedProduct subassembly_product(const LoadedProduct& product, const Subassembl
     const auto& parts = product.product.parts();
     out.product.connect(parts[c.part1].id, c.interface1, parts[c.part2].id, c.interface2, c.name, c.where);
   }
+  // Its own parts' precedences hold while it is built.
+  const auto& parts = product.product.parts();
+  for (const auto& [before, after] : product.product.precedences()) {
+    if (index.count(before) && index.count(after)) out.product.add_precedence(parts[before].id, parts[after].id, parts[after].where);
+  }
   return out;
 }
 
 // The product with each subassembly one part (named after it, at its base's pose, of its
 // members' merged mesh), linked to the rest where its members are. `origin`: what each part
 // of the result stands for, in the product.
+// A precedence that involves a subassembly's part holds for the whole subassembly (it goes in
+// with its parts); one that cannot hold so (a part both before and after the same
+// subassembly) is said in `conflicts`.
 LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<Subassembly>& subassemblies,
-                               std::vector<const Subassembly*>& unit_of, std::vector<PartIndex>& origin) {
+                               std::vector<const Subassembly*>& unit_of, std::vector<PartIndex>& origin,
+                               std::vector<std::string>& conflicts) {
   const auto& parts = product.product.parts();
   LoadedProduct out{empty_like(product.product, product.product.name()), {}};
   std::map<PartIndex, const Subassembly*> member_of;
@@ -91,6 +102,15 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
     const auto [a, ia] = end_of(c.part1, c.interface1);
     const auto [b, ib] = end_of(c.part2, c.interface2);
     out.product.connect(a, ia, b, ib, c.name, c.where);
+  }
+  for (const auto& [before, after] : product.product.precedences()) {
+    const std::string first = end_of(before, "").first, then = end_of(after, "").first;
+    if (first == then) continue;  // within one subassembly: it holds while that is built
+    try {
+      out.product.add_precedence(first, then, parts[after].where);
+    } catch (const DescriptionError& e) {
+      conflicts.push_back(e.what());
+    }
   }
   return out;
 }
@@ -208,7 +228,15 @@ Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequ
 
   std::vector<const Subassembly*> unit_of;
   std::vector<PartIndex> origin;
-  const LoadedProduct units = product_of_units(product, subassemblies, unit_of, origin);
+  std::vector<std::string> conflicts;
+  const LoadedProduct units = product_of_units(product, subassemblies, unit_of, origin, conflicts);
+  if (!conflicts.empty()) {
+    plan.complete = false;
+    for (const auto& why : conflicts) {
+      plan.findings.push_back({"infeasible", "the precedences cannot hold with each subassembly inserted whole: " + why, {}});
+    }
+    return plan;
+  }
   Plan top = plan_assembly(units, sequence, path, options);
   for (PlanStep step : top.steps) {
     const Subassembly* unit = unit_of[step.part];
