@@ -21,7 +21,7 @@ constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
 constexpr std::uint32_t kVersion = 5;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept
 
-// SHA-256 of the file's bytes, then its extension (how it is read), in hex. Meshes come from
+// SHA-256 of the file's bytes, a NUL, then its extension (how it is read), in hex. Meshes come from
 // OEMs (the order desk): with a hash one can collide on purpose (FNV-1a was used before), a
 // crafted file could stand in for another client's cached mesh.
 std::string content_hash(const std::string& bytes, const std::string& extension) {
@@ -30,6 +30,7 @@ std::string content_hash(const std::string& bytes, const std::string& extension)
   unsigned int length = 0;
   if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1 ||
       EVP_DigestUpdate(context.get(), bytes.data(), bytes.size()) != 1 ||
+      EVP_DigestUpdate(context.get(), "\0", 1) != 1 ||
       EVP_DigestUpdate(context.get(), extension.data(), extension.size()) != 1 ||
       EVP_DigestFinal_ex(context.get(), digest, &length) != 1) {
     throw std::runtime_error("SHA-256 failed");

@@ -30,10 +30,13 @@ class Outbox : public fb::FunctionBlock {
 };
 
 struct Twin {
-  Twin(const twin::LoadedProduct& product, const twin::Plan& plan, bool quote_only = false) : resource("twin", 4096) {
+  Twin(const twin::LoadedProduct& product, const twin::Plan& plan, bool quote_only = false,
+       twin::OrderSettings::Resume resume = {})
+      : resource("twin", 4096) {
     twin::OrderSettings order;
     order.order_id = "o1";
     order.quote_only = quote_only;
+    order.resume = std::move(resume);
     fb::NegotiationSettings negotiation;
     negotiation.quote_patience = std::chrono::milliseconds(0);  // a refused call for quotes ends at the next TICK
     orchestrator = &twin::add_order_network(resource, product, plan, order, negotiation);
@@ -350,6 +353,26 @@ TEST_CASE("orchestrator: no path in cell-sim for a part sends it back to sequenc
   CHECK(steps[0].part == plan.steps[0].part);
   CHECK(steps[1].part != plan.steps[1].part);
   CHECK(std::find(out.spawned.begin(), out.spawned.end(), second) != out.spawned.end());
+}
+
+TEST_CASE("orchestrator: a twin taking up an order whose parts stand does not plan another order around them", "[twin][orchestration]") {
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
+  const twin::Plan& plan = cranfield.plan;
+  const std::string first = "o1/" + cranfield.product.product.parts()[plan.steps[0].part].name;
+  const std::string second = "o1/virtual/" + cranfield.product.product.parts()[plan.steps[1].part].name;
+  twin::OrderSettings::Resume resume;
+  resume.attempt = 2;
+  resume.station = "station-1";
+  resume.placed = {first};
+  resume.used = {first};
+  Twin t(cranfield.product, plan, false, resume);
+  Cell cell;  // as in the test above, which backtracks when nothing stands yet
+  cell.collide = [&](const Data& move, long placed) { return carries(move, second) && placed == 1; };
+  const Outcome out = run(t, cell);
+  CHECK(out.finished);
+  CHECK_FALSE(out.complete);
+  CHECK(out.error.find("it is not planned otherwise around them") != std::string::npos);
+  CHECK(std::count(out.findings.begin(), out.findings.end(), "backtrack") == 0);
 }
 
 TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, with the reason", "[twin][orchestration]") {

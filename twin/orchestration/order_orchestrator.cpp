@@ -638,6 +638,13 @@ void OrderOrchestrator::on_collision(const std::string& reason) {
 void OrderOrchestrator::back_to_sequence_planning() {
   const PartIndex part = plan_.steps[step_].part;
   const std::string& name = product_.product.parts()[part].name;
+  if (!settings_.resume.placed.empty() || !settings_.resume.aside.empty()) {
+    // Parts stand on the station as the stored plan put them: another order from here would
+    // be planned around parts that are not where it assumes.
+    return fail("virtual assembly found no collision-free path in cell-sim for " + step_name(product_.product, plan_.steps[step_]) +
+                " at step " + std::to_string(step_ + 1) + " of the plan its parts on " + settings_.resume.station +
+                " were put in by; it is not planned otherwise around them");
+  }
   if (!plan_.subassemblies.empty()) {
     // The planner takes steps already done only for a product without subassemblies.
     return fail("virtual assembly found no collision-free path in cell-sim for " + step_name(product_.product, plan_.steps[step_]) +

@@ -39,6 +39,7 @@
 #include "twin/orchestration/order_network.hpp"
 #include "twin/orchestration/quote.hpp"
 #include "twin/planning/sequence_planner.hpp"
+#include "twin/planning/subassembly_planner.hpp"
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/html_report.hpp"
 #include "twin/report/plan_json.hpp"
@@ -155,9 +156,9 @@ class TwinProcess {
   twin::Plan plan_order(const twin::LoadedProduct& product, twin::PathPlanner& path, const twin::PlannerOptions& options) {
     const auto stored = store_ ? store_->plan_of(options_.order) : std::vector<state::PlanStepRecord>{};
     if (!stored.empty()) {
-      std::vector<std::string> order;
-      for (const auto& s : stored) order.push_back(s.step);
-      twin::GivenSequencePlanner given(order);
+      std::vector<std::string> ids;
+      for (const auto& s : stored) ids.push_back(s.step);
+      twin::GivenSequencePlanner given(ids);
       twin::Plan plan = twin::plan_assembly(product, given, path, options);
       if (plan.complete) {
         store_->journal("twin-" + options_.order, "plan followed", options_.order,
@@ -176,10 +177,15 @@ class TwinProcess {
   void store_plan(const twin::LoadedProduct& product, const twin::Plan& plan) {
     std::vector<state::PlanStepRecord> steps;
     for (const auto& step : plan.steps) {
-      const std::string name = step.carried.empty() ? product.product.parts()[step.part].name : step.subassembly;
-      steps.push_back({name, step.trajectory.label});
+      const std::string& id = product.product.parts()[step.part].id;
+      steps.push_back({step.carried.empty() ? id : twin::unit_id(id), step.trajectory.label});
     }
-    store_->set_plan(options_.order, steps);
+    try {
+      store_->set_plan(options_.order, steps);
+    } catch (const std::exception& e) {
+      // The order goes on; a twin that takes it up would plan anew (and say so).
+      std::cerr << "order " << options_.order << ": the plan was not stored: " << e.what() << '\n';
+    }
   }
 
   // `reported`: the orchestrator has published FAILED already.

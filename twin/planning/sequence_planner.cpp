@@ -32,11 +32,12 @@ std::vector<PartIndex> SearchSequencePlanner::candidates(const AssemblyScene& sc
 }
 
 std::vector<PartIndex> GivenSequencePlanner::candidates(const AssemblyScene& scene) const {
-  const auto& parts = scene.product().product.parts();
-  for (const std::string& name : order_) {
-    for (PartIndex p = 0; p < parts.size(); ++p) {
-      if (parts[p].name == name && !scene.is_assembled(p)) return {p};
-    }
+  const auto& product = scene.product().product;
+  for (const std::string& id : order_) {
+    const auto part = product.find_part(id);
+    if (!part || scene.is_assembled(*part)) continue;  // another level's, or in already
+    if (scene.frontier().count(*part)) return {*part};
+    return {};  // not allowed yet: the stored order does not hold for this product
   }
   return {};
 }

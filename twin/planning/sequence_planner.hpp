@@ -40,12 +40,14 @@ class SearchSequencePlanner : public SequencePlanner {
   bool backtracks() const override { return true; }
 };
 
-// An order given by name (a part's, or a subassembly's where the scene holds it as one
-// body): the first of them not assembled yet. One candidate, no backtracking. A twin that
-// takes an order up plans again in the order its predecessor began to build.
+// An order given by part IDs (a subassembly, where the scene holds it as one body, by
+// "subassembly " and its base's ID, as subassembly_planner names it): the first of them not
+// assembled yet, where the links and precedences allow it now; else nothing. One candidate,
+// no backtracking. A twin that takes an order up plans again in the order its predecessor
+// began to build.
 class GivenSequencePlanner : public SequencePlanner {
  public:
-  explicit GivenSequencePlanner(std::vector<std::string> order) : order_(std::move(order)) {}
+  explicit GivenSequencePlanner(std::vector<std::string> ids) : order_(std::move(ids)) {}
   std::string name() const override { return "given"; }
   std::vector<PartIndex> candidates(const AssemblyScene& scene) const override;
   bool backtracks() const override { return false; }

@@ -61,7 +61,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
   for (const auto& s : subassemblies) {
     for (PartIndex m : s.members) member_of[m] = &s;
   }
-  std::map<const Subassembly*, std::string> unit_id;
+  std::map<const Subassembly*, std::string> id_of_unit;
   for (PartIndex p = 0; p < parts.size(); ++p) {
     const auto it = member_of.find(p);
     if (it == member_of.end()) {
@@ -74,7 +74,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
     const Subassembly& s = *it->second;
     if (p != s.members.front()) continue;
     DigitalPart unit;
-    unit.id = "subassembly " + parts[p].id;
+    unit.id = unit_id(parts[p].id);
     unit.name = s.name;
     unit.final_pose = parts[p].final_pose;
     unit.where = parts[p].where;
@@ -86,7 +86,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
         }
       }
     }
-    unit_id[&s] = unit.id;
+    id_of_unit[&s] = unit.id;
     out.product.add_part(std::move(unit));
     out.meshes.push_back(merged_mesh(product, s.members));
     unit_of.push_back(&s);
@@ -95,7 +95,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
   const auto end_of = [&](PartIndex p, const std::string& interface) -> std::pair<std::string, std::string> {
     const auto it = member_of.find(p);
     if (it == member_of.end()) return {parts[p].id, interface};
-    return {unit_id.at(it->second), parts[p].name + "/" + interface};
+    return {id_of_unit.at(it->second), parts[p].name + "/" + interface};
   };
   for (const Connection& c : product.product.connections()) {
     if (member_of.count(c.part1) && member_of.count(c.part2) && member_of[c.part1] == member_of[c.part2]) continue;

@@ -17,6 +17,10 @@ struct Subassembly {
   std::vector<PartIndex> members;  // in the product's order; the first is its base
 };
 
+// The ID of the part that stands for a subassembly whose base has `base_id` when the product
+// is planned with each subassembly as one body.
+inline std::string unit_id(const std::string& base_id) { return "subassembly " + base_id; }
+
 // The box of `parts` at their final poses, in the product's frame.
 Eigen::AlignedBox3d final_bounds(const LoadedProduct& product, const std::vector<PartIndex>& parts);
 
