@@ -49,6 +49,7 @@ LoadedProduct subassembly_product(const LoadedProduct& product, const Subassembl
 // The product with each subassembly one part (named after it, at its base's pose, of its
 // members' merged mesh), linked to the rest where its members are. `origin`: what each part
 // of the result stands for, in the product.
+//
 // A precedence that involves a subassembly's part holds for the whole subassembly (it goes in
 // with its parts); one that cannot hold so (a part both before and after the same
 // subassembly) is said in `conflicts`.
