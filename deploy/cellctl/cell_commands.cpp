@@ -22,6 +22,7 @@
 #include "deploy/cellctl/remote_submit.hpp"
 #include "deploy/cellctl/supervisor.hpp"
 #include "deploy/cellctl/text_table.hpp"
+#include "deploy/cellctl/twin_identities.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -227,12 +228,19 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   observer.on_status([ids](const cell::OrderStatus& s) {
     if (ids.count(s.order_id().to_string())) print_progress(s);
   });
+  TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
   for (auto& order : orders) {
+    const std::optional<std::string> identity = identities.take();
+    if (!identity) {
+      throw std::runtime_error(std::to_string(orders.size()) + " orders at once need as many twin identities; the cell has " +
+                               std::to_string(cell.twin_identities) + " (twin_identities in " + cell.file.string() + ")");
+    }
+    identities.bind(order.id, *identity);
     // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
     const auto argv = twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence, o.path,
                                 cell.state_dir, wait_s);
     order.sim_start = observer.sim_now();
-    order.twin = std::make_unique<Process>("twin-" + order.id, argv);
+    order.twin = std::make_unique<Process>("twin-" + order.id, with_identity(argv, *identity));
   }
   for (std::size_t running = orders.size(); running > 0;) {
     running = 0;
@@ -369,7 +377,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       throw;
     }
     const auto log = [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; };
-    OrderDesk desk(cell, store, log);
+    OrderDesk desk(cell, store, observer.participant(), log);
     RemoteDesk remote(cell, store, observer, log);
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
               << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"

@@ -11,6 +11,12 @@
 namespace cellctl {
 namespace {
 
+// twin-1, twin-2, ...: the twins' identities (twin_identities.hpp), which nothing else may be.
+bool is_twin_identity(const std::string& id) {
+  return id.size() > 5 && id.rfind("twin-", 0) == 0 && id.find_first_not_of("0123456789", 5) == std::string::npos;
+}
+
+
 std::string where(const std::filesystem::path& file, const YAML::Node& node) {
   return file.string() + ":" + std::to_string(node.Mark().line + 1);
 }
@@ -178,7 +184,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
-              "setup_cost", "currency", "standby_twins"});
+              "setup_cost", "currency", "standby_twins", "twin_identities"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -215,6 +221,10 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   }
   read(file, root, "standby_twins", c.standby_twins);
   if (c.standby_twins < 0 || c.standby_twins > 16) throw ConfigError(where(file, root["standby_twins"]) + ": standby_twins must be 0..16");
+  read(file, root, "twin_identities", c.twin_identities);
+  if (c.twin_identities < 1 || c.twin_identities > 256) {
+    throw ConfigError(where(file, root["twin_identities"]) + ": twin_identities must be 1..256");
+  }
   read_cost(file, root, "setup_cost", c.setup_cost);
   read(file, root, "currency", c.currency);
   if (c.currency.empty() || c.currency.size() > 8) throw ConfigError(where(file, root["currency"]) + ": currency is 1 to 8 characters");
@@ -272,13 +282,14 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
       throw ConfigError(where(file, node) + ": a resource id is 1 to 64 of A-Z, a-z, 0-9, '.', '-' and '_' ('" + id + "' is not)");
     }
     if (!ids.insert(id).second) throw ConfigError(where(file, node) + ": a second resource is called '" + id + "'");
+    if (is_twin_identity(id)) throw ConfigError(where(file, node) + ": '" + id + "' is the name of a twin's identity");
   }
   // A client's id names its DDS-Security identity too: none may be another's.
   ids.insert({"cell-sim", "twin", "cellctl", "order-desk"});
   for (const auto& id : c.clients) {
-    if (!ids.insert(id).second) {
+    if (!ids.insert(id).second || is_twin_identity(id)) {
       throw ConfigError(where(file, root["clients"]) + ": the client '" + id + "' has the name of a resource, of another client or of " +
-                        "cell-sim, twin, cellctl or order-desk");
+                        "cell-sim, twin, twin-N, cellctl or order-desk");
     }
   }
   for (std::size_t i = 0; i < c.stations.size(); ++i) {
@@ -300,6 +311,16 @@ std::filesystem::path CellConfig::state_folder() const {
                                      : home && *home ? std::filesystem::path(home) / ".local" / "state"
                                                      : std::filesystem::temp_directory_path();
   return base / "agile-cell" / ("domain-" + std::to_string(domain));
+}
+
+std::vector<std::string> CellConfig::twin_identity_names() const {
+  std::vector<std::string> names;
+  for (int i = 1; i <= twin_identities; ++i) names.push_back("twin-" + std::to_string(i));
+  return names;
+}
+
+std::vector<std::string> CellConfig::twin_identities_in_use() const {
+  return security_dir.empty() ? std::vector<std::string>{} : twin_identity_names();
 }
 
 dds::ParticipantSettings CellConfig::participant_settings(const std::string& identity) const {

@@ -89,8 +89,13 @@ struct CellConfig {
   // `standby_twins:` twins cellctl up starts before orders come, so that an order's twin has
   // joined the cell already (deploy/cellctl/twin_pool.hpp); 0: each twin starts with its order.
   int standby_twins = 1;
+  // `twin_identities:` with security, the twins that may run at once, standby ones included:
+  // each has a certificate of its own, twin-1 .. twin-N (deploy/cellctl/twin_identities.hpp).
+  int twin_identities = 10;
 
   std::vector<std::string> resource_ids() const;
+  std::vector<std::string> twin_identity_names() const;  // twin-1 .. twin-N
+  std::vector<std::string> twin_identities_in_use() const;  // those with security, none without
   // How a participant of this cell with `identity` (docs/security.md) joins its domain.
   dds::ParticipantSettings participant_settings(const std::string& identity) const;
   std::filesystem::path state_folder() const;

@@ -4,13 +4,14 @@
 
 namespace cellctl {
 
-OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
-                     int max_deaths)
+OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, dds::ParticipantPtr participant,
+                     std::function<void(const std::string&)> log, int max_deaths)
     : cell_(cell),
       store_(store),
       log_(std::move(log)),
       max_deaths_(max_deaths),
-      standby_(twin_standby_argv(cell, executable_dir()), cell.standby_twins, log_) {}
+      identities_(cell.twin_identities_in_use(), std::move(participant)),
+      standby_(twin_standby_argv(cell, executable_dir()), cell.standby_twins, identities_, log_) {}
 
 OrderDesk::~OrderDesk() { interrupt_all(); }
 
@@ -19,12 +20,13 @@ void OrderDesk::tend() {
   const auto now = std::chrono::steady_clock::now();
   std::vector<std::pair<std::string, int>> ended;  // order, its twin's exit code
   for (auto it = twins_.begin(); it != twins_.end();) {
-    const int code = it->second->poll();
+    const int code = it->second.process->poll();
     if (code < 0) {
       ++it;
       continue;
     }
     ended.emplace_back(it->first, code);
+    identities_.give_back(it->second.identity);
     it = twins_.erase(it);
   }
   // Read after the twins ended: what each wrote last is in.
@@ -60,21 +62,35 @@ void OrderDesk::tend() {
       log_("order " + id + " failed: " + why);
       continue;
     }
+    // Every identity runs a twin: the order waits for one to end (uncounted).
+    if (standby_.standing_by() == 0 && !identities_.any_free()) continue;
     try {
       const int attempt = store_.count_attempt(id);
       // Until the twin says more: one killed before it wrote a word counts as died.
       store_.set_order(id, "SUBMITTED", o.reason);
       const auto order_args = twin_order_args(cell_, id, o.product, o.out, o.sequence, o.path, cell_.state_folder(), 30, o.quote);
-      auto twin = standby_.take("twin-" + id, order_args);
-      const bool was_standing_by = twin != nullptr;
-      if (!twin) {
-        twin = std::make_unique<Process>("twin-" + id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence,
-                                                                 o.path, cell_.state_folder(), 30, o.quote));
+      Twin twin = standby_.take("twin-" + id, id, order_args);
+      const bool was_standing_by = twin.process != nullptr;
+      if (!twin.process) {
+        const std::optional<std::string> identity = identities_.take();
+        if (!identity) continue;
+        twin.identity = *identity;
+        try {
+          identities_.bind(id, twin.identity);
+          twin.process = std::make_unique<Process>(
+              "twin-" + id, with_identity(twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
+                                                    cell_.state_folder(), 30, o.quote),
+                                          twin.identity));
+        } catch (...) {
+          identities_.give_back(twin.identity);
+          throw;
+        }
       }
       // The pid says which process is the order's twin (a standby one has no --order to see).
       store_.journal("cellctl", "twin started", id,
-                     "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin->pid()) +
-                         (was_standing_by ? ", standing by" : ""));
+                     "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin.process->pid()) +
+                         (was_standing_by ? ", standing by" : "") +
+                         (twin.identity.empty() ? "" : ", identity " + twin.identity));
       twins_[id] = std::move(twin);
       if (attempt > 1) log_("order " + id + ": twin started again (attempt " + std::to_string(attempt) + ")");
     } catch (const std::exception& e) {
@@ -85,8 +101,9 @@ void OrderDesk::tend() {
 
 void OrderDesk::interrupt_all() {
   std::vector<Process*> all;
-  for (auto& [id, twin] : twins_) all.push_back(twin.get());
+  for (auto& [id, twin] : twins_) all.push_back(twin.process.get());
   stop_all(all);
+  for (auto& [id, twin] : twins_) identities_.give_back(twin.identity);
   twins_.clear();
 }
 

@@ -8,7 +8,8 @@
 // crashed) counts, and after `max_deaths` of them the order fails with the reason. So does
 // one the cell stopped kMaxAttemptsPerDeath times as often: nothing loops for ever.
 // An order's twin is a standby one where one stands by (twin_pool.hpp); the journal's
-// "twin started" says its pid.
+// "twin started" says its pid. With security each twin has an identity of its own, bound to
+// its order (twin_identities.hpp); an order waits while every identity runs a twin.
 
 #include <chrono>
 #include <functional>
@@ -25,8 +26,9 @@ namespace cellctl {
 
 class OrderDesk {
  public:
-  OrderDesk(const CellConfig& cell, state::CellStore& store, std::function<void(const std::string&)> log,
-            int max_deaths = 5);
+  // `participant`: cellctl up's, which binds twins to orders under security.
+  OrderDesk(const CellConfig& cell, state::CellStore& store, dds::ParticipantPtr participant,
+            std::function<void(const std::string&)> log, int max_deaths = 5);
   static constexpr int kMaxAttemptsPerDeath = 4;
   ~OrderDesk();
 
@@ -42,7 +44,8 @@ class OrderDesk {
   std::function<void(const std::string&)> log_;
   int max_deaths_;
   std::map<std::string, int> deaths_;  // order -> its twins that died (since this desk started)
-  std::map<std::string, std::unique_ptr<Process>> twins_;                   // order -> its twin
+  TwinIdentities identities_;
+  std::map<std::string, Twin> twins_;                                        // order -> its twin
   std::map<std::string, std::chrono::steady_clock::time_point> not_before_;  // order -> next start
   TwinPool standby_;
 };

@@ -29,7 +29,8 @@ Grant resource(const std::string& id, const std::string& role, const Topics& own
   Grant g{id, role, {id},
           {"cell/capabilities", "cell/command_events", "cell/negotiation/proposals", "cell/negotiation/replies"},
           own_command_topics + Topics{"cell/cancel_requests", "cell/negotiation/calls", "cell/negotiation/awards",
-                                      "cell/negotiation/releases", "cell/orders/status", "cell/clock"} + kEveryone};
+                                      "cell/negotiation/releases", "cell/orders/status", "cell/orders/twins",
+                                      "cell/clock"} + kEveryone};
   if (moves) {  // it asks cell-sim to move its bodies
     g.publish.push_back("cell/sim/requests");
     g.subscribe.push_back("cell/sim/replies");
@@ -50,14 +51,15 @@ void criteria_xml(std::ostream& out, const char* tag, const Topics& topics, cons
   out << "        </" << tag << ">\n";
 }
 
-// The owned topics (dds::owned_topic) and those it speaks on as itself in the identity's own
-// partitions when it writes them, in every partition when it reads them; the others in the
-// default partition.
+// The owned topics (dds::owned_topic), an order's (dds::order_scoped_topic) and those it speaks
+// on as itself in the identity's own partitions when it writes them, in every partition when
+// it reads them; the others in the default partition.
 void topics_xml(std::ostream& out, const char* tag, const Topics& topics, const Topics& owned_partitions,
                 const Topics& as_itself) {
   Topics owned, other;
   for (const auto& t : topics) {
-    const bool own = dds::owned_topic(t) || std::find(as_itself.begin(), as_itself.end(), t) != as_itself.end();
+    const bool own = dds::owned_topic(t) || dds::order_scoped_topic(t) ||
+                     std::find(as_itself.begin(), as_itself.end(), t) != as_itself.end();
     (own ? owned : other).push_back(t);
   }
   criteria_xml(out, tag, other, {});
@@ -69,7 +71,8 @@ void topics_xml(std::ostream& out, const char* tag, const Topics& topics, const 
 std::vector<Grant> cell_grants(const CellConfig& cell) {
   std::vector<Grant> grants;
   grants.push_back({"cell-sim", "cell-sim", {"cell-sim"}, {"cell/sim/replies", "cell/clock", "cell/capabilities"},
-                    Topics{"cell/sim/requests", "cell/negotiation/replies", "cell/orders/status"} + kEveryone});
+                    Topics{"cell/sim/requests", "cell/negotiation/replies", "cell/orders/status", "cell/orders/twins"} +
+                        kEveryone});
   Topics commanded;  // what a twin commands: the arms and the robots
   for (const auto& s : cell.stations) {
     grants.push_back(resource(s.id, "station", {commands(s.id), commands(s.arm)}, true));
@@ -90,16 +93,20 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
     grants.push_back(g);
     commanded.push_back(commands(r.id));
   }
-  grants.push_back({"twin", "twin", {},
-                    Topics{"cell/orders/status", "cell/orders/result", "cell/negotiation/calls", "cell/negotiation/awards",
-                           "cell/negotiation/releases", "cell/cancel_requests", "cell/sim/requests"} + commanded,
-                    Topics{"cell/clock", "cell/capabilities", "cell/negotiation/proposals", "cell/negotiation/replies",
-                           "cell/command_events", "cell/sim/replies"} + kEveryone});
+  // One identity per twin that runs at once; each speaks for the orders bound to it alone.
+  for (const auto& twin : cell.twin_identity_names()) {
+    grants.push_back({twin, "twin", {twin},
+                      Topics{"cell/orders/status", "cell/orders/result", "cell/negotiation/calls", "cell/negotiation/awards",
+                             "cell/negotiation/releases", "cell/cancel_requests", "cell/sim/requests"} + commanded,
+                      Topics{"cell/clock", "cell/capabilities", "cell/negotiation/proposals", "cell/negotiation/replies",
+                             "cell/command_events", "cell/sim/replies"} + kEveryone});
+  }
   const Topics observer = Topics{"cell/clock", "cell/capabilities", "cell/orders/status", "cell/orders/result",
-                                 "cell/command_events"} + kEveryone;
-  grants.push_back({"cellctl", "cellctl", {}, {}, observer});
+                                 "cell/orders/twins", "cell/command_events"} + kEveryone;
+  // Both start twins (cellctl run; cellctl up's desk) and bind them to their orders.
+  grants.push_back({"cellctl", "cellctl", {}, {"cell/orders/twins"}, observer});
   // cellctl up: it observes the cell and runs the order desk of every client.
-  Grant desk{"order-desk", "order-desk", {}, {}, observer};
+  Grant desk{"order-desk", "order-desk", {}, {"cell/orders/twins"}, observer};
   for (const auto& c : cell.clients) {
     desk.publish = desk.publish + Topics{desk_topic("replies", c), desk_topic("results", c)};
     desk.subscribe = desk.subscribe + Topics{desk_topic("files", c), desk_topic("orders", c)};

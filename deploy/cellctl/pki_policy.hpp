@@ -22,8 +22,8 @@ struct Grant {
   std::vector<std::string> as_itself = {};
 };
 
-// One per process of the cell (cell-sim, each station, robot and buffer), one for every twin
-// ("twin"), one for cellctl, the operator's observer, one for cellctl up ("order-desk"), and
+// One per process of the cell (cell-sim, each station, robot and buffer), one per twin that
+// may run at once (twin-1 .. twin-N, the file's twin_identities), one for cellctl, the operator's observer, one for cellctl up ("order-desk"), and
 // one per client of the file's `clients:`.
 std::vector<Grant> cell_grants(const CellConfig& cell);
 

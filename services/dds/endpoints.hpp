@@ -9,6 +9,7 @@
 #include <deque>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <type_traits>
 #include <utility>
@@ -32,6 +33,7 @@
 
 #include "services/dds/participant.hpp"
 #include "services/dds/qos.hpp"
+#include "services/dds/twin_bindings.hpp"
 
 namespace dds {
 
@@ -56,14 +58,29 @@ inline bool access_controlled(const fdds::DomainParticipant& participant) {
 // (deploy/cellctl/pki_policy.cpp).
 inline bool owned_topic(const std::string& topic) { return topic == "cell/capabilities" || topic == "cell/command_events"; }
 
+// Topics a twin writes for its order. Under DDS-Security each twin writes them in the
+// partition of its own identity, and a reader takes a sample only from the twin its order is
+// bound to (twin_bindings.hpp). The commands to a buffer come from robots, whose readers say
+// who speaks for them (NodeConfig::commanded_by_destination).
+inline bool order_scoped_topic(const std::string& topic) {
+  return topic == "cell/orders/status" || topic == "cell/orders/result" || topic == "cell/negotiation/calls" ||
+         topic == "cell/negotiation/awards" || topic == "cell/negotiation/releases" || topic == "cell/cancel_requests" ||
+         topic.rfind("cell/commands/", 0) == 0;
+}
+
 template <class T, class = void>
 struct has_resource_id : std::false_type {};
 template <class T>
 struct has_resource_id<T, std::void_t<decltype(std::declval<const T&>().resource_id())>> : std::true_type {};
-
-// The resource a sample speaks for (Reader): its writer must write in that resource's partition.
+template <class T, class = void>
+struct has_order_id : std::false_type {};
 template <class T>
-using Speaker = std::function<std::string(const T&)>;
+struct has_order_id<T, std::void_t<decltype(std::declval<const T&>().order_id())>> : std::true_type {};
+
+// Whom a sample speaks for (Reader): its writer must write in the partition of that name (a
+// resource's id, a twin's identity). nullopt: not known yet; the sample waits for it.
+template <class T>
+using Speaker = std::function<std::optional<std::string>(const T&)>;
 
 // Settings with the partition(s) `owner` writes an owned topic in.
 inline QosSettings owned_by(std::vector<std::string> owner, QosSettings settings = {}) {
@@ -106,9 +123,15 @@ fdds::Topic* topic_on(fdds::DomainParticipant& participant, const std::string& n
 template <class T, class PubSubType>
 class Writer : private fdds::DataWriterListener {
  public:
+  // Under DDS-Security, an order's topics (order_scoped_topic) go in the partition of the
+  // writer's identity unless `settings` names others.
   Writer(ParticipantPtr participant, const std::string& topic, TopicKind kind, const QosSettings& settings = {})
       : participant_(std::move(participant)) {
-    publisher_ = participant_->create_publisher(with_partitions(fdds::PUBLISHER_QOS_DEFAULT, settings.partitions));
+    std::vector<std::string> partitions = settings.partitions;
+    if (partitions.empty() && order_scoped_topic(topic) && access_controlled(*participant_)) {
+      partitions = {security_identity(*participant_)};
+    }
+    publisher_ = participant_->create_publisher(with_partitions(fdds::PUBLISHER_QOS_DEFAULT, partitions));
     writer_ = publisher_->create_datawriter(topic_on<PubSubType>(*participant_, topic), writer_qos(kind, settings), this);
     if (!writer_) throw std::runtime_error("cannot create a writer on " + topic + refusal_reason(*participant_));
   }
@@ -232,12 +255,20 @@ class Reader : private fdds::DataReaderListener {
   // `speaker`: the resource a sample speaks for, whose partition its writer must write in for
   // it to count under access control (owned topics: the sample's resource_id). The reader then
   // reads every partition.
+  // An order's topics (order_scoped_topic), under access control: the twin the sample's order
+  // is bound to; a sample whose order has no binding yet waits for it (at most kHeld).
   Reader(ParticipantPtr participant, const std::string& topic, TopicKind kind, std::function<void(const T&)> on_sample,
          std::function<void(const T&)> on_gone = {}, const QosSettings& settings = {}, Speaker<T> speaker = {})
       : participant_(std::move(participant)), kind_(kind), speaker_(std::move(speaker)), on_sample_(std::move(on_sample)),
         on_gone_(std::move(on_gone)) {
     if constexpr (has_resource_id<T>::value) {
       if (!speaker_ && owned_topic(topic)) speaker_ = [](const T& s) { return s.resource_id().to_string(); };
+    }
+    if constexpr (has_order_id<T>::value) {
+      if (!speaker_ && order_scoped_topic(topic) && access_controlled(*participant_)) {
+        bindings_ = twin_bindings(participant_);
+        speaker_ = [b = bindings_.get()](const T& s) { return b->identity_of(s.order_id().to_string()); };
+      }
     }
     subscriber_ = participant_->create_subscriber(with_partitions(
         fdds::SUBSCRIBER_QOS_DEFAULT, settings.partitions.empty() && speaker_ ? every_partition(*participant_)
@@ -246,11 +277,14 @@ class Reader : private fdds::DataReaderListener {
     topic_ = topic;
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
+    // A binding that comes lets the samples waiting for it go on.
+    if (bindings_) listener_ = bindings_->listen([this] { drain(reader_); });
   }
   // A drain already under way finishes first; later callbacks find the reader closed.
   ~Reader() override {
     reader_->set_listener(nullptr);
     closed_ = true;
+    if (bindings_) bindings_->forget(listener_);  // a call under way ends first
     while (requests_ != 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     subscriber_->delete_datareader(reader_);
     participant_->delete_subscriber(subscriber_);
@@ -292,11 +326,16 @@ class Reader : private fdds::DataReaderListener {
   // came while another thread's callback was folded into this drain would wait for the next
   // sample (under TSan, the last of a burst's 9 834 command events waited for ever so).
   void drain_once(fdds::DataReader* reader) {
+    deliver_held();
     fdds::LoanableSequence<T> samples;
     fdds::SampleInfoSeq infos;
     const auto visit = [&](auto&& each) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        if (infos[i].valid_data && from_its_owner(samples[i], infos[i])) each(samples[i]);
+        if (!infos[i].valid_data) continue;
+        const bool gone = infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE;
+        const Verdict v = from_its_owner(samples[i], infos[i].sample_identity.writer_guid(), gone);
+        if (v == Verdict::take) each(samples[i]);
+        if (v == Verdict::hold) hold(samples[i], infos[i].sample_identity.writer_guid(), gone);
       }
       reader->return_loan(samples, infos);
     };
@@ -315,19 +354,57 @@ class Reader : private fdds::DataReaderListener {
     }
   }
 
+  enum class Verdict { take, drop, hold };
+
   // Under DDS-Security a resource may write an owned topic (or one it speaks on for itself) in
-  // its own partition only; a sample it wrote there for another resource is dropped (the
-  // writer said once, on stderr).
-  bool from_its_owner(const T& sample, const fdds::SampleInfo& info) {
-    if (!check_writers_) return true;
-    const auto writer = info.sample_identity.writer_guid();
-    const std::string speaker = speaker_(sample);
-    if (writer_speaks_for(*participant_, writer, speaker)) return true;
-    if (impostors_.insert(writer).second) {
-      std::cerr << "dropped a sample on " << topic_ << " for '" << speaker << "' from writer " << writer
-                << ", which DDS-Security lets write only for another resource\n";
+  // its own partition only, a twin its order's topics in its own; a sample written for another
+  // is dropped (the writer said once, on stderr). A sample whose order is bound to no twin yet
+  // waits. An instance's end (`gone`) counts from a writer whose samples counted before: the
+  // order of a twin that died is bound to the next twin by then.
+  Verdict from_its_owner(const T& sample, const eprosima::fastrtps::rtps::GUID_t& writer, bool gone) {
+    if (!check_writers_) return Verdict::take;
+    if (gone && trusted_.count(writer)) return Verdict::take;
+    const std::optional<std::string> speaker = speaker_(sample);
+    if (!speaker) return Verdict::hold;
+    if (writer_speaks_for(*participant_, writer, *speaker)) {
+      if (kind_ == TopicKind::state) trusted_.insert(writer);
+      return Verdict::take;
     }
-    return false;
+    if (impostors_.insert(writer).second) {
+      std::cerr << "dropped a sample on " << topic_ << " for '" << *speaker << "' from writer " << writer
+                << ", which DDS-Security lets write only for another\n";
+    }
+    return Verdict::drop;
+  }
+
+  struct Held {
+    T sample;
+    eprosima::fastrtps::rtps::GUID_t writer;
+    bool gone;
+  };
+  static constexpr std::size_t kHeld = 64;
+
+  void hold(const T& sample, const eprosima::fastrtps::rtps::GUID_t& writer, bool gone) {
+    if (held_.size() >= kHeld) {
+      std::cerr << "dropped a sample on " << topic_ << " from writer " << held_.front().writer
+                << ": no twin was bound to its order while " << kHeld << " more came\n";
+      held_.pop_front();
+    }
+    held_.push_back({sample, writer, gone});
+  }
+
+  // The held samples whose order has a binding now, in the order they came.
+  void deliver_held() {
+    std::deque<Held> waiting;
+    while (!held_.empty()) {
+      Held h = std::move(held_.front());
+      held_.pop_front();
+      const Verdict v = from_its_owner(h.sample, h.writer, h.gone);
+      const auto& deliver = h.gone ? on_gone_ : on_sample_;
+      if (v == Verdict::take && deliver) deliver(h.sample);
+      if (v == Verdict::hold) waiting.push_back(std::move(h));
+    }
+    held_ = std::move(waiting);
   }
 
   ParticipantPtr participant_;
@@ -335,7 +412,12 @@ class Reader : private fdds::DataReaderListener {
   Speaker<T> speaker_;
   bool check_writers_ = false;
   std::string topic_;
-  std::set<eprosima::fastrtps::rtps::GUID_t> impostors_;  // used by the draining thread only
+  // Used by the draining thread only:
+  std::set<eprosima::fastrtps::rtps::GUID_t> impostors_;
+  std::set<eprosima::fastrtps::rtps::GUID_t> trusted_;  // state topics: writers that spoke for their own
+  std::deque<Held> held_;
+  std::shared_ptr<TwinBindings> bindings_;
+  int listener_ = -1;
   std::function<void(const T&)> on_sample_;
   std::function<void(const T&)> on_gone_;
   std::atomic<int> requests_{0};  // drain calls not yet served

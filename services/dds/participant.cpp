@@ -18,22 +18,34 @@
 #include <fastrtps/utils/IPLocator.h>
 
 #include "cell_idl/simulationPubSubTypes.h"
+#include "services/dds/twin_bindings.hpp"
 
 namespace dds {
 
 constexpr std::uint32_t kMaxParticipantsPerHost = 32;
 
-namespace {
-
-}  // namespace
-
 // Says when another participant's lease ran out while it may still live (a process starved
 // of CPU for the whole lease): until discovery matches the two again, what they write to
 // each other is lost, and a call that gets no answer from a live resource is the sign.
 // Keeps the partitions of every remote writer that has some (writer_speaks_for()).
+// Holds what else is kept per participant: its identity, and the twins' bindings.
 class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
  public:
-  explicit DiscoveryLog(std::string name) : name_(std::move(name)) {}
+  DiscoveryLog(std::string name, std::string identity) : name_(std::move(name)), identity_(std::move(identity)) {}
+
+  const std::string& identity() const { return identity_; }
+  std::shared_ptr<TwinBindings> bindings(const ParticipantPtr& participant) {
+    // Not under mutex_: making the reader takes Fast DDS's locks, under which Fast DDS calls
+    // on_publisher_discovery.
+    std::lock_guard<std::mutex> lock(bindings_mutex_);
+    if (!bindings_) bindings_ = std::make_shared<TwinBindings>(participant);
+    return bindings_;
+  }
+  // Before the participant's entities are deleted: the bindings' reader is one of them.
+  void drop_bindings() {
+    std::lock_guard<std::mutex> lock(bindings_mutex_);
+    bindings_.reset();
+  }
 
   // Called before the writer is matched to any reader of ours, so before its first sample.
   // Kept when it goes: its last samples may still be taken after (a state topic's instance
@@ -71,6 +83,9 @@ class DiscoveryLog : public eprosima::fastdds::dds::DomainParticipantListener {
 
  private:
   std::string name_;
+  std::string identity_;
+  std::mutex bindings_mutex_;
+  std::shared_ptr<TwinBindings> bindings_;
   mutable std::mutex mutex_;
   std::map<eprosima::fastrtps::rtps::GUID_t, std::vector<std::string>> partitions_;
 };
@@ -80,6 +95,18 @@ bool writer_speaks_for(const eprosima::fastdds::dds::DomainParticipant& particip
   if (writer.guidPrefix == participant.guid().guidPrefix) return true;  // ours: checked when created
   const auto* log = dynamic_cast<const DiscoveryLog*>(participant.get_listener());
   return !resource_id.empty() && log && log->writes_in(writer, resource_id);
+}
+
+std::string security_identity(const eprosima::fastdds::dds::DomainParticipant& participant) {
+  const auto* log = dynamic_cast<const DiscoveryLog*>(participant.get_listener());
+  return log ? log->identity() : "";
+}
+
+std::shared_ptr<TwinBindings> twin_bindings(const ParticipantPtr& participant) {
+  // The listener is ours to change (make_participant made it); Fast DDS hands it out const.
+  auto* log = const_cast<DiscoveryLog*>(dynamic_cast<const DiscoveryLog*>(participant->get_listener()));
+  if (!log) throw std::logic_error("twin_bindings: not a participant of make_participant");
+  return log->bindings(participant);
 }
 
 namespace {
@@ -166,8 +193,9 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   // dies is noticed by the 5 s liveliness of its capability, not by this lease.
   qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
   qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(20.0);
+  std::string identity;
   if (!settings.security.dir.empty()) {
-    const std::string identity = settings.security.identity.empty() ? name : settings.security.identity;
+    identity = settings.security.identity.empty() ? name : settings.security.identity;
     const IdentityFiles files = identity_files(settings.security.dir, identity);
     check_identity(files, identity);
     apply_security(qos, files);
@@ -178,7 +206,7 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   static std::mutex creating;
   std::lock_guard<std::mutex> one_at_a_time(creating);
   DomainParticipantFactory* factory = DomainParticipantFactory::get_instance();
-  auto log = std::make_shared<DiscoveryLog>(name);
+  auto log = std::make_shared<DiscoveryLog>(name, identity);
   DomainParticipant* participant = factory->create_participant(settings.domain_id, qos, log.get(), StatusMask::none());
   if (!participant) {
     throw std::runtime_error("cannot create DDS participant '" + name + "' on domain " +
@@ -186,6 +214,7 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   }
   reserve_reader_slots(*participant);
   return ParticipantPtr(participant, [log](DomainParticipant* p) {
+    log->drop_bindings();
     p->set_listener(nullptr);
     p->delete_contained_entities();
     DomainParticipantFactory::get_instance()->delete_participant(p);

@@ -30,4 +30,7 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
 bool writer_speaks_for(const eprosima::fastdds::dds::DomainParticipant& participant,
                        const eprosima::fastrtps::rtps::GUID_t& writer, const std::string& resource_id);
 
+// The identity a participant was made with under DDS-Security; "" without.
+std::string security_identity(const eprosima::fastdds::dds::DomainParticipant& participant);
+
 }  // namespace dds

@@ -1,6 +1,6 @@
 // What DDS-Security costs, with it off and on in the same run (docs/performance.md):
 //  1. a command's round trip to a buffer process until SUCCEEDED (hired as a twin hires it,
-//     sent as the mobile robot sends gives: the identities `twin` and `mobile-robot-1`);
+//     sent as the mobile robot sends gives: the identities `twin-1` and `mobile-robot-1`);
 //  2. a twin's start to its first status, and to virtual assembly begun (Cranfield, with
 //     cell-sim and a station running), started with its order and as a standby twin;
 //  3. `cellctl run` of Cranfield on the default cell, wall time from start to end.
@@ -47,7 +47,11 @@ void command_round_trips(const Mode& m, int rounds) {
   test::ChildProcess buffer(m.with({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(kDomain), "--stock",
                                     "Part=1000000"}),
                             "/dev/null");
-  auto hirer = dds::make_participant("bench-twin", m.as("twin"));
+  // The hirer is a twin: its order bound to its identity first, as cellctl does.
+  auto binder = dds::make_participant("bench-binder", m.as("cellctl"));
+  cellctl::TwinIdentities ids(m.pki.empty() ? std::vector<std::string>{} : std::vector<std::string>{"twin-1"}, binder);
+  ids.bind("bench", "twin-1");
+  auto hirer = dds::make_participant("bench-twin", m.as("twin-1"));
   auto sender = dds::make_participant("bench-robot", m.as("mobile-robot-1"));
   std::string why;
   const std::string award = test::hire(hirer, "bench-buffer", "bench", "give", {"", "Part", rounds + 20}, &why);
@@ -73,8 +77,9 @@ void twin_starts(const Mode& m, int launches) {
   test::ChildProcess station(m.with({STATION_EXE, "--domain", domain, "--id", "station-1"}), "/dev/null");
   auto observer = dds::make_participant("bench-observer", m.as("cellctl"));
   const auto twin = m.with({TWIN_EXE, "--domain", domain, "--quiet"});
-  report("security " + m.name + ": twin start", bench::twin_launches(observer, twin, launches, false, m.name));
-  report("security " + m.name + ": standby twin", bench::twin_launches(observer, twin, launches, true, m.name));
+  const std::vector<std::string> ids = m.pki.empty() ? std::vector<std::string>{} : std::vector<std::string>{"twin-1", "twin-2"};
+  report("security " + m.name + ": twin start", bench::twin_launches(observer, twin, launches, false, m.name, ids));
+  report("security " + m.name + ": standby twin", bench::twin_launches(observer, twin, launches, true, m.name, ids));
   station.stop();
   sim.stop();
 }

@@ -23,9 +23,11 @@ struct TwinLaunches {
   int never_begun = 0;                      // within 10 s
 };
 
-// `twin_args`: the twin and the cell's options (no order); `observer` reads the orders' status.
+// `twin_args`: the twin and the cell's options (no order); `observer` reads the orders' status
+// and, under security, binds each order to its twin's identity (one of `identities`).
 inline TwinLaunches twin_launches(const dds::ParticipantPtr& observer, std::vector<std::string> twin_args, int rounds,
-                                  bool standing_by, const std::string& tag) {
+                                  bool standing_by, const std::string& tag,
+                                  const std::vector<std::string>& identities = {}) {
   using namespace std::chrono_literals;
   std::mutex mutex;
   std::condition_variable changed;
@@ -45,22 +47,25 @@ inline TwinLaunches twin_launches(const dds::ParticipantPtr& observer, std::vect
   };
   auto standby_args = twin_args;
   standby_args.push_back("--standby");
-  cellctl::TwinPool pool(standby_args, standing_by ? 1 : 0);
+  cellctl::TwinIdentities ids(identities, observer);
+  cellctl::TwinPool pool(standby_args, standing_by ? 1 : 0, ids);
   TwinLaunches out;
   for (int i = 0; i < rounds; ++i) {
     const std::string order = tag + (standing_by ? "-standby-" : "-cold-") + std::to_string(i);
-    std::unique_ptr<cellctl::Process> twin;
+    cellctl::Twin twin;
     if (standing_by) std::this_thread::sleep_for(1500ms);
     const auto start = Clock::now();
     if (standing_by) {
-      twin = pool.take("twin-" + order, order_args(order));
-      if (!twin) throw std::runtime_error("no standby twin");
+      twin = pool.take("twin-" + order, order, order_args(order));
+      if (!twin.process) throw std::runtime_error("no standby twin");
       pool.tend();
     } else {
+      twin.identity = ids.take().value();
+      ids.bind(order, twin.identity);
       auto argv = twin_args;
       const auto more = order_args(order);
       argv.insert(argv.end(), more.begin(), more.end());
-      twin = std::make_unique<cellctl::Process>("twin-" + order, argv, "/dev/null");
+      twin.process = std::make_unique<cellctl::Process>("twin-" + order, cellctl::with_identity(argv, twin.identity), "/dev/null");
     }
     std::unique_lock<std::mutex> lock(mutex);
     if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
@@ -77,7 +82,8 @@ inline TwinLaunches twin_launches(const dds::ParticipantPtr& observer, std::vect
       ++out.never_begun;
     }
     lock.unlock();
-    twin->stop();
+    twin.process->stop();
+    ids.give_back(twin.identity);
   }
   return out;
 }

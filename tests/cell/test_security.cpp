@@ -18,6 +18,7 @@
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "deskPubSubTypes.h"
+#include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "tests/support/cell_test.hpp"
 
@@ -93,7 +94,7 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
   CHECK(mode_of(pki / "ca.key.pem") == 0600);
   CHECK(fs::exists(pki / "ca.cert.pem"));
   CHECK(test::read_text(pki / "governance.p7s").find("application/x-pkcs7-signature") != std::string::npos);
-  for (const std::string id : {"cell-sim", "station-1", "mobile-robot-1", "buffer-1", "buffer-2", "twin", "cellctl"}) {
+  for (const std::string id : {"cell-sim", "station-1", "mobile-robot-1", "buffer-1", "buffer-2", "twin-1", "twin-10", "cellctl"}) {
     INFO(id);
     const fs::path own = pki / "identities" / id;
     CHECK(mode_of(own) == 0700);
@@ -101,8 +102,10 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
     CHECK(fs::exists(own / "cert.pem"));
     CHECK(test::read_text(own / "permissions.p7s").find("<subject_name>CN=" + id + "</subject_name>") != std::string::npos);
   }
+  CHECK_FALSE(fs::exists(pki / "identities" / "twin-11"));  // the default cell's twin_identities: 10
   // By role: a buffer reads its own commands only and commands nobody; a twin commands the arm
-  // and the robot but publishes no capability; cellctl only reads.
+  // and the robot but publishes no capability, each twin in its own partition; cellctl binds
+  // twins to orders and only reads besides.
   const auto permissions = [&](const std::string& id) { return test::read_text(pki / "identities" / id / "permissions.xml"); };
   const auto section = [](const std::string& xml, const std::string& tag) {  // every one of them
     std::string all;
@@ -114,16 +117,24 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
   CHECK(section(permissions("buffer-1"), "subscribe").find("cell/commands/buffer-1") != std::string::npos);
   CHECK(permissions("buffer-1").find("cell/commands/buffer-2") == std::string::npos);
   CHECK(section(permissions("buffer-1"), "publish").find("cell/commands/") == std::string::npos);
-  CHECK(section(permissions("twin"), "publish").find("cell/commands/arm-1") != std::string::npos);
-  CHECK(section(permissions("twin"), "publish").find("cell/capabilities") == std::string::npos);
-  CHECK(section(permissions("cellctl"), "publish").empty());
+  CHECK(section(permissions("twin-1"), "publish").find("cell/commands/arm-1") != std::string::npos);
+  CHECK(section(permissions("twin-1"), "publish").find("cell/capabilities") == std::string::npos);
+  CHECK(permissions("twin-2").find("<topic>cell/orders/status</topic>") != std::string::npos);
+  CHECK(section(permissions("twin-2"), "publish").find("<partition>twin-2</partition>") != std::string::npos);
+  CHECK(section(permissions("twin-2"), "publish").find("<partition>twin-1</partition>") == std::string::npos);
+  CHECK(section(permissions("cellctl"), "publish").find("<topic>cell/orders/twins</topic>") != std::string::npos);
+  CHECK(section(permissions("cellctl"), "publish").find("cell/commands/") == std::string::npos);
+  CHECK(section(permissions("station-1"), "publish").find("cell/orders/twins") == std::string::npos);
   CHECK(section(permissions("mobile-robot-1"), "publish").find("cell/commands/buffer-1") != std::string::npos);
   // A robot writes its gives in its own partition, and a buffer reads its commands in every one
   // (it checks that a give comes from the robot it names).
   CHECK(permissions("mobile-robot-1").find("<topic>cell/commands/buffer-2</topic>\n          </topics>\n          <partitions>\n"
                                            "            <partition>mobile-robot-1</partition>") != std::string::npos);
-  CHECK(permissions("buffer-1").find("<topic>cell/commands/buffer-1</topic>\n          </topics>\n          <partitions>\n"
-                                     "            <partition>*</partition>") != std::string::npos);
+  const std::string buffer_1 = permissions("buffer-1");
+  const auto own_commands = buffer_1.find("<topic>cell/commands/buffer-1</topic>");
+  REQUIRE(own_commands != std::string::npos);
+  CHECK(buffer_1.substr(own_commands, buffer_1.find("</subscribe>", own_commands) - own_commands).find("<partition>*</partition>") !=
+        std::string::npos);
 
   // A cell keeps its CA: a second init refuses and changes nothing.
   const std::string ca_key = test::read_text(pki / "ca.key.pem");
@@ -187,7 +198,7 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
       CHECK(test::read_text(log).find("cannot create a writer on cell/capabilities: this identity's DDS-Security permissions "
                                       "do not allow it") != std::string::npos);
     };
-    refused_capability("buffer-7", "twin");
+    refused_capability("buffer-7", "twin-1");
     refused_capability("buffer-1", "buffer-2");
     CHECK(trusted_sees.seen().count("buffer-7") == 0);
     auto as_buffer_2 = dds::make_participant("test-buffer-2", {std::stoi(domain), true, {pki, "buffer-2"}});
@@ -253,6 +264,56 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     CHECK(answered("own/give")->find("names no award of buffer-1") != std::string::npos);
     CHECK_FALSE(answered("forged/give"));
     CHECK(test::appears(dir / "up.log", "dropped a sample on cell/commands/buffer-1 for 'mobile-robot-2'", 10s));
+  }
+
+  {  // Each twin speaks for the orders bound to it alone (by cellctl, on cell/orders/twins):
+     // twin-2 cannot write in twin-1's partition, every reader drops what it writes for an
+     // order bound to twin-1, and what it writes for an order not bound yet waits for the binding.
+    dds::Writer<cell::TwinBinding, cell::TwinBindingPubSubType> binder(trusted, "cell/orders/twins", dds::TopicKind::state);
+    const auto bind = [&](const std::string& order, const std::string& identity) {
+      cell::TwinBinding b;
+      b.order_id(order);
+      b.identity(identity);
+      binder.write(b);
+    };
+    std::mutex mutex;
+    std::set<std::string> seen;  // orders whose status came
+    dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType> statuses(
+        trusted, "cell/orders/status", dds::TopicKind::state, [&](const cell::OrderStatus& s) {
+          std::lock_guard<std::mutex> lock(mutex);
+          seen.insert(s.order_id().to_string());
+        });
+    const auto saw = [&](const std::string& order) {
+      std::lock_guard<std::mutex> lock(mutex);
+      return seen.count(order) > 0;
+    };
+    const auto wait_to_see = [&](const std::string& order) {
+      const auto deadline = std::chrono::steady_clock::now() + 20s;
+      while (!saw(order) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+      return saw(order);
+    };
+    auto as_twin_2 = dds::make_participant("test-twin-2", {std::stoi(domain), true, {pki, "twin-2"}});
+    using StatusWriter = dds::Writer<cell::OrderStatus, cell::OrderStatusPubSubType>;
+    CHECK_THROWS_WITH((StatusWriter(as_twin_2, "cell/orders/status", dds::TopicKind::state, dds::owned_by({"twin-1"}))),
+                      Catch::Contains("cannot create a writer on cell/orders/status: this identity's DDS-Security"));
+    StatusWriter status(as_twin_2, "cell/orders/status", dds::TopicKind::state);  // in its partition, twin-2
+    bind("bound-to-1", "twin-1");
+    bind("bound-to-2", "twin-2");
+    REQUIRE(status.wait_for_readers(1, 10s));
+    for (const std::string order : {"bound-to-1", "bound-later", "bound-to-2"}) {
+      cell::OrderStatus s;
+      s.order_id(order);
+      s.state(cell::SUBMITTED);
+      s.message("written by twin-2");
+      status.write(s);
+    }
+    REQUIRE(wait_to_see("bound-to-2"));
+    CHECK_FALSE(saw("bound-later"));
+    bind("bound-later", "twin-2");
+    CHECK(wait_to_see("bound-later"));
+    CHECK_FALSE(saw("bound-to-1"));
+    INFO(up_log());
+    CHECK(test::appears(dir / "up.log", "dropped a sample on cell/orders/status for 'twin-1'", 10s));
   }
 
   {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.

@@ -543,7 +543,11 @@ int main(int argc, char** argv) {
   add_order_options(app, o, rates);
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(o.dds, all_interfaces);
-  if (o.dds.security.identity.empty()) o.dds.security.identity = "twin";  // every twin has the role's identity
+  if (!o.dds.security.dir.empty() && o.dds.security.identity.empty()) {
+    // Whoever starts a twin gives it an identity and binds its order to it (docs/security.md).
+    std::cerr << "error: a twin with --security needs --identity (twin-1 .. twin-N: cellctl starts twins so)\n";
+    return 2;
+  }
   std::signal(SIGINT, stop);
   std::signal(SIGTERM, stop);
   services::stop_with_parent();

@@ -1,0 +1,46 @@
+#include "deploy/cellctl/twin_identities.hpp"
+
+#include "cell_idl/ordersPubSubTypes.h"
+#include "services/dds/endpoints.hpp"
+
+namespace cellctl {
+
+struct TwinIdentities::Writer {
+  explicit Writer(dds::ParticipantPtr participant) : bindings(std::move(participant), "cell/orders/twins", dds::TopicKind::state) {}
+  dds::Writer<cell::TwinBinding, cell::TwinBindingPubSubType> bindings;
+};
+
+TwinIdentities::TwinIdentities(const std::vector<std::string>& names, dds::ParticipantPtr participant)
+    : secure_(!names.empty()), free_(names.begin(), names.end()) {
+  if (!secure_) return;
+  writer_ = std::make_unique<Writer>(std::move(participant));
+}
+
+TwinIdentities::~TwinIdentities() = default;
+
+std::optional<std::string> TwinIdentities::take() {
+  if (!secure_) return std::string();
+  if (free_.empty()) return std::nullopt;
+  std::string identity = *free_.begin();
+  free_.erase(free_.begin());
+  return identity;
+}
+
+void TwinIdentities::give_back(const std::string& identity) {
+  if (secure_ && !identity.empty()) free_.insert(identity);
+}
+
+void TwinIdentities::bind(const std::string& order, const std::string& identity) {
+  if (!secure_) return;
+  cell::TwinBinding b;
+  b.order_id(order);
+  b.identity(identity);
+  if (!writer_->bindings.write(b)) throw std::runtime_error("cannot bind order " + order + " to its twin " + identity);
+}
+
+std::vector<std::string> with_identity(std::vector<std::string> argv, const std::string& identity) {
+  if (!identity.empty()) argv.insert(argv.end(), {"--identity", identity});
+  return argv;
+}
+
+}  // namespace cellctl

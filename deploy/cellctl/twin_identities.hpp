@@ -1,0 +1,42 @@
+#pragma once
+// With DDS-Security each running twin has an identity of its own, twin-1 .. twin-N (`cellctl
+// pki init` issues N = the deployment file's twin_identities), and whoever starts a twin binds
+// its order to that identity on cell/orders/twins (services/dds/twin_bindings.hpp): the cell's
+// readers then take an order's status, calls, awards and commands from that twin alone.
+// Without security: no identities, no bindings.
+
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "services/dds/participant.hpp"
+
+namespace cellctl {
+
+class TwinIdentities {
+ public:
+  // `participant`: cellctl's own (cellctl up's, run's), which writes the bindings; `names`:
+  // CellConfig::twin_identities_in_use(), none without security.
+  TwinIdentities(const std::vector<std::string>& names, dds::ParticipantPtr participant);
+  ~TwinIdentities();
+
+  // A free identity ("" without security); nullopt while every one is in use.
+  std::optional<std::string> take();
+  void give_back(const std::string& identity);
+  bool any_free() const { return !secure_ || !free_.empty(); }
+  // Binds `order` to `identity` for the cell's readers; before the twin writes for it.
+  void bind(const std::string& order, const std::string& identity);
+
+ private:
+  struct Writer;
+  bool secure_;
+  std::set<std::string> free_;
+  std::unique_ptr<Writer> writer_;
+};
+
+// The twin's command line with its identity (none without security).
+std::vector<std::string> with_identity(std::vector<std::string> argv, const std::string& identity);
+
+}  // namespace cellctl
