@@ -10,7 +10,7 @@ DeviceBlock::DeviceBlock(std::string name, std::string resource_id, std::set<std
   declare_input("START", {"command_id"});
   declare_input("ORDER_ENDED", {"order_id"});
   declare_input("ORDER_ACTIVE", {"order_id"});
-  declare_output("ACCEPT", {"command_id"});
+  declare_output("ACCEPT", {"command_id", "order_id"});
   declare_output("PROGRESS", {"progress"});
   declare_output("DONE");
   declare_output("FAIL", {"reason"});
@@ -63,7 +63,7 @@ void DeviceBlock::receive(const Event& event) {
                              {"part", get_or<std::string>(event.data, "part", "")}});
     }
     commands_[id] = event.data;
-    emit("ACCEPT", {{"command_id", id}});
+    emit("ACCEPT", {{"command_id", id}, {"order_id", get_or<std::string>(event.data, "order_id", "")}});
     return;
   }
   if (event.name == "ORDER_ENDED") {

@@ -331,7 +331,9 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   });
   n.subscribe<cell::CancelRequest, cell::CancelRequestPubSubType>(
       "cancels", "cell/cancel_requests", TopicKind::events,
-      [](const cell::CancelRequest& c) { return fb::Data{{"command_id", c.command_id().to_string()}}; });
+      [](const cell::CancelRequest& c) {
+        return fb::Data{{"command_id", c.command_id().to_string()}, {"order_id", c.order_id().to_string()}};
+      });
   resource.connect("cancels", "IND", "lifecycle", "CANCEL");
   resource.connect(dev, "ACCEPT", "lifecycle", "COMMAND");
   resource.connect("lifecycle", "START", dev, "START");

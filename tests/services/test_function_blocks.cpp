@@ -178,3 +178,23 @@ TEST_CASE("command life cycle with a queue: a queued command is canceled at once
   REQUIRE(names<fb::CommandLifecycle>(next) == Names{"SUCCEEDED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(next[1].data, "command_id") == "c3");  // c2 is gone
 }
+
+TEST_CASE("command life cycle: a cancel counts only from the command's own order", "[fb][lifecycle]") {
+  fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle", fb::CommandLifecycle::WhenBusy::queue);
+  const auto command = [&](const char* id, const char* order) {
+    f.send("COMMAND", {{"command_id", std::string(id)}, {"order_id", std::string(order)}});
+  };
+  const auto cancel = [&](const char* id, const char* order) {
+    return names<fb::CommandLifecycle>(f.send("CANCEL", {{"command_id", std::string(id)}, {"order_id", std::string(order)}}));
+  };
+  command("c1", "o1");
+  command("c2", "o1");
+  CHECK(cancel("c1", "o2").empty());  // executing, another order's
+  CHECK(cancel("c2", "o2").empty());  // queued, another order's
+  CHECK(cancel("c2", "").empty());
+  CHECK(f.block().queued() == 1);
+  CHECK(cancel("c2", "o1") == Names{"CANCELED"});
+  CHECK(cancel("c1", "o1") == Names{"CANCELING", "STOP"});
+  CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
+  CHECK(cancel("c1", "o1").empty());  // ended: nothing to cancel
+}

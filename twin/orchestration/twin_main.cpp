@@ -372,9 +372,10 @@ class TwinProcess {
         dds::command_qos()));
     r.connect("orchestrator", "COMMAND", "commands", "REQ");
     publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "orchestrator",
-                                                                "CANCEL", [](const fb::Data& d) {
+                                                                "CANCEL", [this](const fb::Data& d) {
                                                                   cell::CancelRequest c;
                                                                   c.command_id(fb::get<std::string>(d, "command_id"));
+                                                                  c.order_id(options_.order);
                                                                   return c;
                                                                 });
     auto& sim = publish<cell::SimRequest, cell::SimRequestPubSubType>(
