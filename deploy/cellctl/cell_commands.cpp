@@ -220,6 +220,14 @@ std::vector<Order> orders_of(const SubmitOptions& o) {
   return out;
 }
 
+// With security each twin at once needs an identity of its own (twin_identities.hpp).
+void check_identities_for(const CellConfig& cell, std::size_t orders) {
+  if (!cell.twin_identities_in_use().empty() && orders > static_cast<std::size_t>(cell.twin_identities)) {
+    throw ConfigError(cell.file.string() + ": " + std::to_string(orders) + " orders at once need as many twin identities; " +
+                      "twin_identities is " + std::to_string(cell.twin_identities));
+  }
+}
+
 // Spawns a twin per order at once and follows them to their ends, printing their progress.
 void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Order>& orders, CellObserver& observer,
                 double wait_s) {
@@ -228,13 +236,10 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   observer.on_status([ids](const cell::OrderStatus& s) {
     if (ids.count(s.order_id().to_string())) print_progress(s);
   });
+  check_identities_for(cell, orders.size());
   TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
   for (auto& order : orders) {
     const std::optional<std::string> identity = identities.take();
-    if (!identity) {
-      throw std::runtime_error(std::to_string(orders.size()) + " orders at once need as many twin identities; the cell has " +
-                               std::to_string(cell.twin_identities) + " (twin_identities in " + cell.file.string() + ")");
-    }
     identities.bind(order.id, *identity);
     // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
     const auto argv = twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence, o.path,
@@ -342,6 +347,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   up->add_option("CELL", cell_options->cell, "Deployment file (the same as --cell)")->check(CLI::ExistingFile);
   up->callback([cell_options, &exit_code] {
     const CellConfig cell = cell_options->load();
+    cell.check_twin_identities();
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
     bool stale = false;
@@ -523,12 +529,14 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
+    cell.check_twin_identities();
+    auto orders = orders_of(*submit_options);
+    check_identities_for(cell, orders.size());
     CellObserver observer(cell.participant_settings("cellctl"));
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
     std::cout << "cell up on domain " << cell.domain << ", real-time factor " << cell.real_time_factor << std::endl;
-    auto orders = orders_of(*submit_options);
     run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
     const bool all = report_orders(orders, observer);
     exit_code = all ? 0 : 1;

@@ -323,6 +323,16 @@ std::vector<std::string> CellConfig::twin_identities_in_use() const {
   return security_dir.empty() ? std::vector<std::string>{} : twin_identity_names();
 }
 
+void CellConfig::check_twin_identities() const {
+  for (const auto& name : twin_identities_in_use()) {
+    if (!std::filesystem::exists(security_dir / "identities" / name / "cert.pem")) {
+      throw ConfigError(file.string() + ": security: " + security_dir.string() + " has no identity " + name +
+                        " (twin_identities: " + std::to_string(twin_identities) + "); `cellctl pki issue " +
+                        security_dir.string() + " " + name + " --cell " + file.string() + "` issues it");
+    }
+  }
+}
+
 dds::ParticipantSettings CellConfig::participant_settings(const std::string& identity) const {
   dds::ParticipantSettings s;
   s.domain_id = domain;

@@ -96,6 +96,9 @@ struct CellConfig {
   std::vector<std::string> resource_ids() const;
   std::vector<std::string> twin_identity_names() const;  // twin-1 .. twin-N
   std::vector<std::string> twin_identities_in_use() const;  // those with security, none without
+  // With security: throws ConfigError naming an identity of twin_identities that the
+  // security folder lacks (a folder issued before the file asked for more twins).
+  void check_twin_identities() const;
   // How a participant of this cell with `identity` (docs/security.md) joins its domain.
   dds::ParticipantSettings participant_settings(const std::string& identity) const;
   std::filesystem::path state_folder() const;

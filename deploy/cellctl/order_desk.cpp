@@ -87,11 +87,11 @@ void OrderDesk::tend() {
         }
       }
       // The pid says which process is the order's twin (a standby one has no --order to see).
-      store_.journal("cellctl", "twin started", id,
-                     "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin.process->pid()) +
-                         (was_standing_by ? ", standing by" : "") +
-                         (twin.identity.empty() ? "" : ", identity " + twin.identity));
-      twins_[id] = std::move(twin);
+      const std::string started = "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin.process->pid()) +
+                                  (was_standing_by ? ", standing by" : "") +
+                                  (twin.identity.empty() ? "" : ", identity " + twin.identity);
+      twins_[id] = std::move(twin);  // before anything else can throw: its identity comes back when it ends
+      store_.journal("cellctl", "twin started", id, started);
       if (attempt > 1) log_("order " + id + ": twin started again (attempt " + std::to_string(attempt) + ")");
     } catch (const std::exception& e) {
       store_.set_order(id, "FAILED", std::string("its twin cannot be started: ") + e.what(), 1);

@@ -74,7 +74,7 @@ void add_pki_command(CLI::App& app, int& exit_code) {
   CLI::App* issue_cmd = pki_cmd->add_subcommand(
       "issue", "Issue (again) one identity of the cell with the CA in DIR: a new key, certificate and permissions");
   add_options(issue_cmd, *o);
-  issue_cmd->add_option("NAME", o->name, "The identity: cell-sim, a resource id of the file, twin or cellctl")->required();
+  issue_cmd->add_option("NAME", o->name, "The identity: cell-sim, a resource id of the file, twin-N, cellctl, order-desk or a client")->required();
   issue_cmd->add_option("--backdate-days", o->backdate_days, "Valid from this many days ago (a test: an expired identity)")
       ->check(CLI::NonNegativeNumber);
   issue_cmd->callback([o, &exit_code] {

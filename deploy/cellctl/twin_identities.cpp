@@ -1,5 +1,7 @@
 #include "deploy/cellctl/twin_identities.hpp"
 
+#include <algorithm>
+
 #include "cell_idl/ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 
@@ -21,13 +23,15 @@ TwinIdentities::~TwinIdentities() = default;
 std::optional<std::string> TwinIdentities::take() {
   if (!secure_) return std::string();
   if (free_.empty()) return std::nullopt;
-  std::string identity = *free_.begin();
-  free_.erase(free_.begin());
+  std::string identity = free_.front();
+  free_.pop_front();
   return identity;
 }
 
 void TwinIdentities::give_back(const std::string& identity) {
-  if (secure_ && !identity.empty()) free_.insert(identity);
+  if (secure_ && !identity.empty() && std::find(free_.begin(), free_.end(), identity) == free_.end()) {
+    free_.push_back(identity);
+  }
 }
 
 void TwinIdentities::bind(const std::string& order, const std::string& identity) {

@@ -5,9 +5,9 @@
 // readers then take an order's status, calls, awards and commands from that twin alone.
 // Without security: no identities, no bindings.
 
+#include <deque>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -32,7 +32,7 @@ class TwinIdentities {
  private:
   struct Writer;
   bool secure_;
-  std::set<std::string> free_;
+  std::deque<std::string> free_;  // the longest free first: a name just given back is taken last
   std::unique_ptr<Writer> writer_;
 };
 

@@ -25,12 +25,17 @@ Twin TwinPool::take(const std::string& name, const std::string& order, const std
   while (!standby_.empty()) {
     Twin twin = std::move(standby_.front());
     standby_.pop_front();
-    if (twin.process->poll() < 0) {
-      identities_.bind(order, twin.identity);  // before the twin writes a word for the order
-      if (twin.process->write_input(input)) {
-        twin.process->rename(name);
-        return twin;
+    try {
+      if (twin.process->poll() < 0) {
+        identities_.bind(order, twin.identity);  // before the twin writes a word for the order
+        if (twin.process->write_input(input)) {
+          twin.process->rename(name);
+          return twin;
+        }
       }
+    } catch (...) {
+      identities_.give_back(twin.identity);
+      throw;
     }
     identities_.give_back(twin.identity);
   }

@@ -277,8 +277,12 @@ class Reader : private fdds::DataReaderListener {
     topic_ = topic;
     reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
-    // A binding that comes lets the samples waiting for it go on.
-    if (bindings_) listener_ = bindings_->listen([this] { drain(reader_); });
+    // A binding that comes lets the samples waiting for it go on (one that came before
+    // listen() too).
+    if (bindings_) {
+      listener_ = bindings_->listen([this] { drain(reader_); });
+      drain(reader_);
+    }
   }
   // A drain already under way finishes first; later callbacks find the reader closed.
   ~Reader() override {
@@ -332,10 +336,13 @@ class Reader : private fdds::DataReaderListener {
     const auto visit = [&](auto&& each) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
         if (!infos[i].valid_data) continue;
-        const bool gone = infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE;
-        const Verdict v = from_its_owner(samples[i], infos[i].sample_identity.writer_guid(), gone);
+        // A binding that came during this drain: what waited for it goes first, in order.
+        if (!held_.empty()) deliver_held();
+        const Source source{infos[i].sample_identity.writer_guid(), infos[i].instance_handle,
+                            infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
+        const Verdict v = from_its_owner(samples[i], source);
         if (v == Verdict::take) each(samples[i]);
-        if (v == Verdict::hold) hold(samples[i], infos[i].sample_identity.writer_guid(), gone);
+        if (v == Verdict::hold) hold(samples[i], source);
       }
       reader->return_loan(samples, infos);
     };
@@ -355,52 +362,59 @@ class Reader : private fdds::DataReaderListener {
   }
 
   enum class Verdict { take, drop, hold };
+  struct Source {
+    eprosima::fastrtps::rtps::GUID_t writer;
+    fdds::InstanceHandle_t instance;
+    bool gone;  // the instance's end (its writers gone, or disposed)
+  };
 
   // Under DDS-Security a resource may write an owned topic (or one it speaks on for itself) in
   // its own partition only, a twin its order's topics in its own; a sample written for another
-  // is dropped (the writer said once, on stderr). A sample whose order is bound to no twin yet
-  // waits. An instance's end (`gone`) counts from a writer whose samples counted before: the
-  // order of a twin that died is bound to the next twin by then.
-  Verdict from_its_owner(const T& sample, const eprosima::fastrtps::rtps::GUID_t& writer, bool gone) {
+  // resource is dropped (the writer said once, on stderr). An order's sample waits while its
+  // order is bound to no twin, or to another than its writer's: the binding of a twin started
+  // anew for the order (another identity) may come after the new twin's first samples. An
+  // instance's end counts from a writer whose samples of that instance counted before: the
+  // order of a twin that died may be bound to the next twin by then.
+  Verdict from_its_owner(const T& sample, const Source& from) {
     if (!check_writers_) return Verdict::take;
-    if (gone && trusted_.count(writer)) return Verdict::take;
+    if (from.gone && trusted_.count({from.writer, from.instance})) return Verdict::take;
     const std::optional<std::string> speaker = speaker_(sample);
     if (!speaker) return Verdict::hold;
-    if (writer_speaks_for(*participant_, writer, *speaker)) {
-      if (kind_ == TopicKind::state) trusted_.insert(writer);
+    if (writer_speaks_for(*participant_, from.writer, *speaker)) {
+      if (kind_ == TopicKind::state) trusted_.insert({from.writer, from.instance});
       return Verdict::take;
     }
-    if (impostors_.insert(writer).second) {
-      std::cerr << "dropped a sample on " << topic_ << " for '" << *speaker << "' from writer " << writer
-                << ", which DDS-Security lets write only for another\n";
+    if (impostors_.insert(from.writer).second) {
+      std::cerr << (bindings_ ? "held" : "dropped") << " a sample on " << topic_ << " for '" << *speaker << "' from writer "
+                << from.writer << ", which DDS-Security lets write only for another"
+                << (bindings_ ? " (it counts only once its order is bound to its writer)" : "") << "\n";
     }
-    return Verdict::drop;
+    return bindings_ ? Verdict::hold : Verdict::drop;
   }
 
   struct Held {
     T sample;
-    eprosima::fastrtps::rtps::GUID_t writer;
-    bool gone;
+    Source from;
   };
   static constexpr std::size_t kHeld = 64;
 
-  void hold(const T& sample, const eprosima::fastrtps::rtps::GUID_t& writer, bool gone) {
+  void hold(const T& sample, const Source& from) {
     if (held_.size() >= kHeld) {
-      std::cerr << "dropped a sample on " << topic_ << " from writer " << held_.front().writer
-                << ": no twin was bound to its order while " << kHeld << " more came\n";
+      std::cerr << "dropped a sample on " << topic_ << " from writer " << held_.front().from.writer
+                << ": its order was bound to no twin, or to another, while " << kHeld << " more came\n";
       held_.pop_front();
     }
-    held_.push_back({sample, writer, gone});
+    held_.push_back({sample, from});
   }
 
-  // The held samples whose order has a binding now, in the order they came.
+  // The held samples whose order is bound to their writer now, in the order they came.
   void deliver_held() {
     std::deque<Held> waiting;
     while (!held_.empty()) {
       Held h = std::move(held_.front());
       held_.pop_front();
-      const Verdict v = from_its_owner(h.sample, h.writer, h.gone);
-      const auto& deliver = h.gone ? on_gone_ : on_sample_;
+      const Verdict v = from_its_owner(h.sample, h.from);
+      const auto& deliver = h.from.gone ? on_gone_ : on_sample_;
       if (v == Verdict::take && deliver) deliver(h.sample);
       if (v == Verdict::hold) waiting.push_back(std::move(h));
     }
@@ -414,7 +428,8 @@ class Reader : private fdds::DataReaderListener {
   std::string topic_;
   // Used by the draining thread only:
   std::set<eprosima::fastrtps::rtps::GUID_t> impostors_;
-  std::set<eprosima::fastrtps::rtps::GUID_t> trusted_;  // state topics: writers that spoke for their own
+  // State topics: the instances each writer spoke for with the right to.
+  std::set<std::pair<eprosima::fastrtps::rtps::GUID_t, fdds::InstanceHandle_t>> trusted_;
   std::deque<Held> held_;
   std::shared_ptr<TwinBindings> bindings_;
   int listener_ = -1;

@@ -28,7 +28,8 @@ class TwinBindings {
   // The identity the order is bound to; nullopt while no binding came.
   std::optional<std::string> identity_of(const std::string& order) const;
 
-  // `changed` is called (on a DDS thread) after each new binding; until forget(id).
+  // `changed` is called (on a DDS thread) after each new binding; until forget(id), which
+  // waits for a call under way. A call must not make or delete a reader of an order's topic.
   int listen(std::function<void()> changed);
   void forget(int id);
 

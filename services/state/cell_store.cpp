@@ -334,12 +334,9 @@ void CellStore::grip(const std::string& order, const std::vector<std::string>& p
   move_parts(order, parts, Place::in_gripper, arm, "on_station", true);
 }
 
-void CellStore::release(const std::string& order, const std::vector<std::string>& parts) {
-  move_parts(order, parts, Place::on_station, "", "in_gripper");
-}
-
-void CellStore::place(const std::string& order, const std::vector<std::string>& parts, const std::string& aside) {
-  move_parts(order, parts, Place::placed, aside, "on_station");
+void CellStore::release(const std::string& order, const std::vector<std::string>& parts, const std::string& into) {
+  if (into.empty()) return move_parts(order, parts, Place::on_station, "", "in_gripper");
+  move_parts(order, parts, Place::placed, into == "product" ? "" : into, "in_gripper");
 }
 
 void CellStore::set_aside(const std::string& order, const std::string& part) {

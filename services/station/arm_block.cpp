@@ -44,8 +44,9 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
       request(sim_.move(gripper_bodies().front(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
     }, op(motion));
   }
-  transition("READY", "START", "READY", [this](const Data&) {
-    if (store() && !held_.empty()) store()->release(held_order_, held_bodies());
+  // `destination`: what the part goes into, for the cell's state (CellStore::release).
+  transition("READY", "START", "READY", [this](const Data& d) {
+    if (store() && !held_.empty()) store()->release(held_order_, held_bodies(), get_or<std::string>(d, "destination", ""));
     held_.clear();
     carried_.clear();
     emit("DONE");

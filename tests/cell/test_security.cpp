@@ -313,7 +313,7 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     CHECK(wait_to_see("bound-later"));
     CHECK_FALSE(saw("bound-to-1"));
     INFO(up_log());
-    CHECK(test::appears(dir / "up.log", "dropped a sample on cell/orders/status for 'twin-1'", 10s));
+    CHECK(test::appears(dir / "up.log", "held a sample on cell/orders/status for 'twin-1'", 10s));
   }
 
   {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <thread>
 
+#include <set>
+
 #include <catch2/catch.hpp>
 
 #include "services/buffer/buffer_block.hpp"
@@ -58,10 +60,24 @@ TEST_CASE("arm: a grip places palm, fingers and carriage, a second grip replaces
   CHECK(f.block().held() == "o1/B1");
 }
 
-TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part until the release", "[fb][arm]") {
+TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part until the release", "[fb][arm][state]") {
   fb::BlockTestFixture<fb::ArmBlock> f("arm", "arm-1", fb::ArmSettings{});
+  const auto dir = std::filesystem::temp_directory_path() / ("agile-cell-blocks-" + std::to_string(::getpid())) / "carried";
+  std::filesystem::remove_all(dir);
+  state::CellStore store(dir);
+  store.open_buffer("buffer-1", {{"Base", 1}, {"Member", 2}});
+  for (const auto& [type, part] : {std::pair{"Base", "o1/base"}, {"Member", "o1/m1"}, {"Member", "o1/m2"}}) {
+    store.give("buffer-1", type, "o1", part, "robot-1");
+    store.deliver("o1", part, "station-1");
+  }
+  REQUIRE(f.block().keep_state_in(store).empty());
+  const auto places = [&] {
+    std::set<std::string> out;
+    for (const auto& p : store.parts("o1")) out.insert(std::string(state::place_name(p.place)) + ":" + p.holder);
+    return out;
+  };
   const fb::Data grasp{{"part", std::string("o1/base")}, {"carried", fb::join_names({"o1/m1", "o1/m2"})},
-                       {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
+                       {"order_id", std::string("o1")}, {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
   REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("g", "grip", grasp))) == Names{"ACCEPT"});
   const auto spawns = f.send("START", {{"command_id", std::string("g")}});
   for (const auto& request : spawns) f.send("SIM_REPLY", reply_to(request));
@@ -77,9 +93,15 @@ TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part un
   };
   const auto holding = move_of("t1");
   for (const char* body : {"o1/base", "o1/m1", "o1/m2"}) CHECK(std::count(holding.begin(), holding.end(), body) == 1);
-  REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("r", "release", {}))) == Names{"ACCEPT"});
+  CHECK(places() == std::set<std::string>{"in_gripper:arm-1"});
+  // The release says what the parts go into: the state records them placed with it, in one
+  // transaction (a twin that dies right after cannot leave them "at the dock").
+  REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("r", "release", {{"order_id", std::string("o1")},
+                                                                         {"destination", std::string("product")}}))) ==
+          Names{"ACCEPT"});
   f.send("START", {{"command_id", std::string("r")}});
   CHECK(f.block().carried().empty());
+  CHECK(places() == std::set<std::string>{"placed:"});
   const auto after = move_of("t2");
   CHECK(std::count(after.begin(), after.end(), "o1/m1") == 0);
   CHECK(std::count(after.begin(), after.end(), "o1/base") == 0);

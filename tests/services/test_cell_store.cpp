@@ -132,16 +132,17 @@ TEST_CASE("a subassembly: its parts stand aside under its name, move to the grip
     }
     return std::pair{state::Place::returned, std::string("none")};
   };
-  // Built aside: placed, held by the subassembly's name.
+  // Built aside: placed by the release itself, held by the subassembly's name.
   for (const char* part : {"o1/shaft", "o1/pendulum"}) {
     store.grip("o1", {part}, "arm-1");
-    store.release("o1", {part});
-    store.place("o1", {part}, "ShaftPendulum");
+    store.release("o1", {part}, "ShaftPendulum");
     CHECK(where(part) == std::pair{state::Place::placed, std::string("ShaftPendulum")});
   }
   store.grip("o1", {"o1/plate"}, "arm-1");
-  store.release("o1", {"o1/plate"});
-  store.place("o1", {"o1/plate"});
+  store.release("o1", {"o1/plate"});  // into nothing named: it stands on the station
+  CHECK(where("o1/plate") == std::pair{state::Place::on_station, std::string()});
+  store.grip("o1", {"o1/plate"}, "arm-1");
+  store.release("o1", {"o1/plate"}, "product");
   // A part standing in the product is not gripped again (the journal says so).
   store.grip("o1", {"o1/plate"}, "arm-1");
   CHECK(where("o1/plate") == std::pair{state::Place::placed, std::string()});
@@ -152,8 +153,7 @@ TEST_CASE("a subassembly: its parts stand aside under its name, move to the grip
   CHECK(where("o1/pendulum") == std::pair{state::Place::in_gripper, std::string("arm-1")});
   require_conserved(store);
   SECTION("inserted: released and placed in the product together") {
-    store.release("o1", {"o1/shaft", "o1/pendulum"});
-    store.place("o1", {"o1/shaft", "o1/pendulum"});
+    store.release("o1", {"o1/shaft", "o1/pendulum"}, "product");
     CHECK(where("o1/pendulum") == std::pair{state::Place::placed, std::string()});
     store.assemble("o1");
     CHECK(store.inventory().at("Pendulum").assembled == 1);

@@ -687,7 +687,8 @@ void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, co
   Data move = command(arm_, turns ? "rotate" : "translate", bodies.front());
   move["path"] = pose_numbers(holding);
   actions_.push_back({Action::command, move});
-  const Data release = command(arm_, "release", bodies.front());
+  Data release = command(arm_, "release", bodies.front());
+  release["destination"] = aside.empty() ? std::string("product") : aside;  // the state records it with the release
   placed_by_[get<std::string>(release, "command_id")] = {{"part", fb::join_names(bodies)}, {"aside", aside}};
   actions_.push_back({Action::command, release});
   Data back = command(arm_, "translate", bodies.front());

@@ -397,10 +397,6 @@ class TwinProcess {
       std::cout << "finding: " << fb::get<std::string>(d, "message") << std::endl;  // also when quiet
     }));
     r.connect("orchestrator", "FINDING", "findings", "REQ");
-    r.add(std::make_unique<fb::ActionBlock>("placed", [this](const fb::Data& d) {
-      if (store_) store_->place(options_.order, fb::split_names(fb::get<std::string>(d, "part")), fb::get<std::string>(d, "aside"));
-    }));
-    r.connect("orchestrator", "PLACED", "placed", "REQ");
     std::optional<twin::Quote> quote;
     r.add(std::make_unique<fb::ActionBlock>("quote", [this, &quote](const fb::Data& d) {
       twin::QuoteBids bids{fb::get<std::string>(d, "station"), fb::get<std::string>(d, "robot"),
