@@ -377,7 +377,7 @@ class Reader : private fdds::DataReaderListener {
   // order of a twin that died may be bound to the next twin by then.
   Verdict from_its_owner(const T& sample, const Source& from) {
     if (!check_writers_) return Verdict::take;
-    if (from.gone && trusted_.count({from.writer, from.instance})) return Verdict::take;
+    if (from.gone && trusted_.erase({from.writer, from.instance}) > 0) return Verdict::take;
     const std::optional<std::string> speaker = speaker_(sample);
     if (!speaker) return Verdict::hold;
     if (writer_speaks_for(*participant_, from.writer, *speaker)) {
@@ -395,8 +395,14 @@ class Reader : private fdds::DataReaderListener {
   struct Held {
     T sample;
     Source from;
+    std::chrono::steady_clock::time_point since;
   };
+  // A binding comes within milliseconds of its twin's first samples. One held longer is not
+  // kept for a later binding: a twin that wrote for another order while its identity was
+  // bound elsewhere must not have those samples count once the identity is bound to that
+  // order (identities go back to a pool).
   static constexpr std::size_t kHeld = 64;
+  static constexpr std::chrono::seconds kHoldFor{5};
 
   void hold(const T& sample, const Source& from) {
     if (held_.size() >= kHeld) {
@@ -404,15 +410,21 @@ class Reader : private fdds::DataReaderListener {
                 << ": its order was bound to no twin, or to another, while " << kHeld << " more came\n";
       held_.pop_front();
     }
-    held_.push_back({sample, from});
+    held_.push_back({sample, from, std::chrono::steady_clock::now()});
   }
 
   // The held samples whose order is bound to their writer now, in the order they came.
   void deliver_held() {
     std::deque<Held> waiting;
+    const auto now = std::chrono::steady_clock::now();
     while (!held_.empty()) {
       Held h = std::move(held_.front());
       held_.pop_front();
+      if (now - h.since > kHoldFor) {
+        std::cerr << "dropped a sample on " << topic_ << " from writer " << h.from.writer << ": its order was not bound to "
+                  << "its writer within " << kHoldFor.count() << " s\n";
+        continue;
+      }
       const Verdict v = from_its_owner(h.sample, h.from);
       const auto& deliver = h.from.gone ? on_gone_ : on_sample_;
       if (v == Verdict::take && deliver) deliver(h.sample);
@@ -428,7 +440,7 @@ class Reader : private fdds::DataReaderListener {
   std::string topic_;
   // Used by the draining thread only:
   std::set<eprosima::fastrtps::rtps::GUID_t> impostors_;
-  // State topics: the instances each writer spoke for with the right to.
+  // State topics: the instances each writer spoke for with the right to, until their end.
   std::set<std::pair<eprosima::fastrtps::rtps::GUID_t, fdds::InstanceHandle_t>> trusted_;
   std::deque<Held> held_;
   std::shared_ptr<TwinBindings> bindings_;

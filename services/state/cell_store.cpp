@@ -335,8 +335,12 @@ void CellStore::grip(const std::string& order, const std::vector<std::string>& p
 }
 
 void CellStore::release(const std::string& order, const std::vector<std::string>& parts, const std::string& into) {
-  if (into.empty()) return move_parts(order, parts, Place::on_station, "", "in_gripper");
-  move_parts(order, parts, Place::placed, into == "product" ? "" : into, "in_gripper");
+  static const std::string aside = "aside:";
+  if (into == "product") return move_parts(order, parts, Place::placed, "", "in_gripper");
+  if (into.rfind(aside, 0) == 0 && into.size() > aside.size()) {
+    return move_parts(order, parts, Place::placed, into.substr(aside.size()), "in_gripper");
+  }
+  move_parts(order, parts, Place::on_station, "", "in_gripper");
 }
 
 void CellStore::set_aside(const std::string& order, const std::string& part) {

@@ -120,9 +120,10 @@ class CellStore {
   void deliver(const std::string& order, const std::string& part, const std::string& station);
   // Several parts at once: a subassembly, gripped by its base, carried and released whole.
   void grip(const std::string& order, const std::vector<std::string>& parts, const std::string& arm);
-  // Let go by the arm. `into` "": they stand on the station; "product": placed in the product
-  // on the station; another name: placed in the subassembly of that name built aside. The
-  // record is the release's own: no twin that dies after it leaves them "at the dock".
+  // Let go by the arm. `into` "product": placed in the product on the station; "aside:NAME":
+  // placed in the subassembly NAME built beside it; anything else: they stand on the
+  // station. The record is the release's own: no twin that dies after it leaves them "at the
+  // dock".
   void release(const std::string& order, const std::vector<std::string>& parts, const std::string& into = "");
   void set_aside(const std::string& order, const std::string& part);
   // The order's product is finished: its parts on the station become assembled.

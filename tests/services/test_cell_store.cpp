@@ -135,7 +135,7 @@ TEST_CASE("a subassembly: its parts stand aside under its name, move to the grip
   // Built aside: placed by the release itself, held by the subassembly's name.
   for (const char* part : {"o1/shaft", "o1/pendulum"}) {
     store.grip("o1", {part}, "arm-1");
-    store.release("o1", {part}, "ShaftPendulum");
+    store.release("o1", {part}, "aside:ShaftPendulum");
     CHECK(where(part) == std::pair{state::Place::placed, std::string("ShaftPendulum")});
   }
   store.grip("o1", {"o1/plate"}, "arm-1");

@@ -688,7 +688,8 @@ void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, co
   move["path"] = pose_numbers(holding);
   actions_.push_back({Action::command, move});
   Data release = command(arm_, "release", bodies.front());
-  release["destination"] = aside.empty() ? std::string("product") : aside;  // the state records it with the release
+  // The state records where the parts go with the release (CellStore::release).
+  release["destination"] = aside.empty() ? std::string("product") : "aside:" + aside;
   placed_by_[get<std::string>(release, "command_id")] = {{"part", fb::join_names(bodies)}, {"aside", aside}};
   actions_.push_back({Action::command, release});
   Data back = command(arm_, "translate", bodies.front());
@@ -889,9 +890,7 @@ void OrderOrchestrator::next_action() {
 
 void OrderOrchestrator::action_done() {
   const Action& a = actions_.front();
-  // Released, the part stands in the product: the durable state says so at once. Recorded
-  // only at the connect after the gripper backed out, a twin that died in between left the
-  // part "at the dock" for the next one, which inserted it again.
+  // Released, the part stands in the product (the arm recorded it so with the release).
   const auto placed = a.kind == Action::command ? placed_by_.find(get<std::string>(a.data, "command_id")) : placed_by_.end();
   if (state() == "PHYSICAL" && placed != placed_by_.end()) {
     emit("PLACED", placed->second);

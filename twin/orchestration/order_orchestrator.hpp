@@ -52,7 +52,8 @@
 //            step), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: the bodies released in place,
-//            aside: the subassembly they were built into aside, "" in the product),
+//            aside: the subassembly they were built into aside, "" in the product; the
+//            arm's release recorded it in the cell's state already: progress only),
 //            FINISHED (complete, error, take_up: ended for the next twin to take the order up)
 
 #include <chrono>
