@@ -222,7 +222,7 @@ std::vector<Order> orders_of(const SubmitOptions& o) {
 
 // With security each twin at once needs an identity of its own (twin_identities.hpp).
 void check_identities_for(const CellConfig& cell, std::size_t orders) {
-  if (!cell.twin_identities_in_use().empty() && orders > static_cast<std::size_t>(cell.twin_identities)) {
+  if (!cell.security_dir.empty() && orders > static_cast<std::size_t>(cell.twin_identities)) {
     throw ConfigError(cell.file.string() + ": " + std::to_string(orders) + " orders at once need as many twin identities; " +
                       "twin_identities is " + std::to_string(cell.twin_identities));
   }
@@ -239,13 +239,11 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   check_identities_for(cell, orders.size());
   TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
   for (auto& order : orders) {
-    const std::optional<std::string> identity = identities.take();
-    identities.bind(order.id, *identity);
-    // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
-    const auto argv = twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence, o.path,
-                                cell.state_dir, wait_s);
     order.sim_start = observer.sim_now();
-    order.twin = std::make_unique<Process>("twin-" + order.id, with_identity(argv, *identity));
+    // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
+    order.twin = identities.start(order.id, twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence,
+                                                      o.path, cell.state_dir, wait_s))
+                     .process;  // check_identities_for: there is an identity for each
   }
   for (std::size_t running = orders.size(); running > 0;) {
     running = 0;

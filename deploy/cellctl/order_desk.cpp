@@ -72,19 +72,9 @@ void OrderDesk::tend() {
       Twin twin = standby_.take("twin-" + id, id, order_args);
       const bool was_standing_by = twin.process != nullptr;
       if (!twin.process) {
-        const std::optional<std::string> identity = identities_.take();
-        if (!identity) continue;
-        twin.identity = *identity;
-        try {
-          identities_.bind(id, twin.identity);
-          twin.process = std::make_unique<Process>(
-              "twin-" + id, with_identity(twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
-                                                    cell_.state_folder(), 30, o.quote),
-                                          twin.identity));
-        } catch (...) {
-          identities_.give_back(twin.identity);
-          throw;
-        }
+        twin = identities_.start(id, twin_argv(cell_, executable_dir(), id, o.product, o.out, o.sequence, o.path,
+                                               cell_.state_folder(), 30, o.quote));
+        if (!twin.process) continue;
       }
       // The pid says which process is the order's twin (a standby one has no --order to see).
       const std::string started = "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin.process->pid()) +

@@ -42,6 +42,18 @@ void TwinIdentities::bind(const std::string& order, const std::string& identity)
   if (!writer_->bindings.write(b)) throw std::runtime_error("cannot bind order " + order + " to its twin " + identity);
 }
 
+Twin TwinIdentities::start(const std::string& order, const std::vector<std::string>& argv, const std::string& stdout_to) {
+  const std::optional<std::string> identity = take();
+  if (!identity) return {};
+  try {
+    bind(order, *identity);
+    return {std::make_unique<Process>("twin-" + order, with_identity(argv, *identity), stdout_to), *identity};
+  } catch (...) {
+    give_back(*identity);
+    throw;
+  }
+}
+
 std::vector<std::string> with_identity(std::vector<std::string> argv, const std::string& identity) {
   if (!identity.empty()) argv.insert(argv.end(), {"--identity", identity});
   return argv;

@@ -11,9 +11,15 @@
 #include <string>
 #include <vector>
 
+#include "deploy/cellctl/processes.hpp"
 #include "services/dds/participant.hpp"
 
 namespace cellctl {
+
+struct Twin {
+  std::unique_ptr<Process> process;
+  std::string identity;  // its DDS-Security identity; "" without security
+};
 
 class TwinIdentities {
  public:
@@ -28,6 +34,9 @@ class TwinIdentities {
   bool any_free() const { return !secure_ || !free_.empty(); }
   // Binds `order` to `identity` for the cell's readers; before the twin writes for it.
   void bind(const std::string& order, const std::string& identity);
+  // A twin for `order` started now (`argv`: the twin with its order's options) with a free
+  // identity, its order bound to it; no process while every identity runs a twin.
+  Twin start(const std::string& order, const std::vector<std::string>& argv, const std::string& stdout_to = "");
 
  private:
   struct Writer;

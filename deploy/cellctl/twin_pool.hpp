@@ -18,11 +18,6 @@
 
 namespace cellctl {
 
-struct Twin {
-  std::unique_ptr<Process> process;
-  std::string identity;  // its DDS-Security identity; "" without security
-};
-
 class TwinPool {
  public:
   // `standby_argv`: a twin with --standby and the cell's options; `size` of them stand by,

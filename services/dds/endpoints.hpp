@@ -330,14 +330,14 @@ class Reader : private fdds::DataReaderListener {
   // came while another thread's callback was folded into this drain would wait for the next
   // sample (under TSan, the last of a burst's 9 834 command events waited for ever so).
   void drain_once(fdds::DataReader* reader) {
-    deliver_held();
+    deliver_held_if_bound();
     fdds::LoanableSequence<T> samples;
     fdds::SampleInfoSeq infos;
     const auto visit = [&](auto&& each) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
         if (!infos[i].valid_data) continue;
         // A binding that came during this drain: what waited for it goes first, in order.
-        if (!held_.empty()) deliver_held();
+        deliver_held_if_bound();
         const Source source{infos[i].sample_identity.writer_guid(), infos[i].instance_handle,
                             infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
         const Verdict v = from_its_owner(samples[i], source);
@@ -413,7 +413,13 @@ class Reader : private fdds::DataReaderListener {
     held_.push_back({sample, from, std::chrono::steady_clock::now()});
   }
 
-  // The held samples whose order is bound to their writer now, in the order they came.
+  // After a new binding: the held samples whose order is bound to their writer now, in the
+  // order they came.
+  void deliver_held_if_bound() {
+    if (held_.empty() || !bindings_ || bindings_->generation() == held_checked_at_) return;
+    held_checked_at_ = bindings_->generation();
+    deliver_held();
+  }
   void deliver_held() {
     std::deque<Held> waiting;
     const auto now = std::chrono::steady_clock::now();
@@ -443,6 +449,7 @@ class Reader : private fdds::DataReaderListener {
   // State topics: the instances each writer spoke for with the right to, until their end.
   std::set<std::pair<eprosima::fastrtps::rtps::GUID_t, fdds::InstanceHandle_t>> trusted_;
   std::deque<Held> held_;
+  unsigned held_checked_at_ = 0;  // the bindings' generation the held samples were last checked at
   std::shared_ptr<TwinBindings> bindings_;
   int listener_ = -1;
   std::function<void(const T&)> on_sample_;

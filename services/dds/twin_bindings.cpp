@@ -45,6 +45,7 @@ void TwinBindings::bind(const std::string& order, const std::string& identity) {
     std::lock_guard<std::mutex> lock(mutex_);
     identities_[order] = identity;
   }
+  ++generation_;
   std::lock_guard<std::mutex> lock(listeners_mutex_);
   for (const auto& [id, changed] : listeners_) changed();
 }

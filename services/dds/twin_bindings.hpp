@@ -6,6 +6,7 @@
 // of an order's topics (endpoints.hpp, order_scoped_topic) takes a sample only from a writer
 // in the partition its order is bound to.
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -27,6 +28,8 @@ class TwinBindings {
 
   // The identity the order is bound to; nullopt while no binding came.
   std::optional<std::string> identity_of(const std::string& order) const;
+  // How many bindings came: what waited for one needs a look only when this changed.
+  unsigned generation() const { return generation_.load(); }
 
   // `changed` is called (on a DDS thread) after each new binding; until forget(id), which
   // waits for a call under way. A call must not make or delete a reader of an order's topic.
@@ -38,6 +41,7 @@ class TwinBindings {
 
   mutable std::mutex mutex_;
   std::map<std::string, std::string> identities_;  // order -> identity
+  std::atomic<unsigned> generation_{0};
   std::mutex listeners_mutex_;  // held while listeners are called: forget() waits for them
   std::map<int, std::function<void()>> listeners_;
   int next_listener_ = 0;

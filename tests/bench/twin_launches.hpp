@@ -60,12 +60,11 @@ inline TwinLaunches twin_launches(const dds::ParticipantPtr& observer, std::vect
       if (!twin.process) throw std::runtime_error("no standby twin");
       pool.tend();
     } else {
-      twin.identity = ids.take().value();
-      ids.bind(order, twin.identity);
       auto argv = twin_args;
       const auto more = order_args(order);
       argv.insert(argv.end(), more.begin(), more.end());
-      twin.process = std::make_unique<cellctl::Process>("twin-" + order, cellctl::with_identity(argv, twin.identity), "/dev/null");
+      twin = ids.start(order, argv, "/dev/null");
+      if (!twin.process) throw std::runtime_error("no twin identity free");
     }
     std::unique_lock<std::mutex> lock(mutex);
     if (changed.wait_for(lock, 10s, [&] { return seen.count(order) > 0; })) {
