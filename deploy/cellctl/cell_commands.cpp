@@ -386,6 +386,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
               << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"
               << std::endl;
+    std::string gave_up;  // why the supervisor stopped the cell
     while (!stop_requested) {
       if (world_lost) desk.interrupt_all();
       world_lost = false;
@@ -394,6 +395,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       if (const std::string why = supervisor.tend(); !why.empty()) {
         std::cerr << "error: " << why << "; stopping the cell. Look at that process's output above, fix the cause, "
                   << "and start the cell again\n";
+        gave_up = "gave up: " + why;
         exit_code = 1;
         break;
       }
@@ -401,7 +403,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     desk.interrupt_all();  // their orders are INTERRUPTED: the next up on this state takes them up
     supervisor.stop();
-    store.journal("cellctl", "down", "", exit_code == 0 ? "" : "gave up");
+    store.journal("cellctl", "down", "", gave_up);
     fs::remove(pid_file(cell.domain));
     std::cout << "cell down" << std::endl;
   });
@@ -477,12 +479,18 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     std::cout << "Cell on domain " << cell.domain << ": " << observer.resources().size() << " resources\n\n";
     resources.print(std::cout);
     TextTable inventory({"part type", "initial", "in buffers", "assembled", "on stations", "in transit", "inspection", ""});
+    long inspection = 0;
     for (const auto& [type, c] : report["inventory"].items()) {
       inventory.add_row({type, c["initial"].dump(), c["in_buffers"].dump(), c["assembled"].dump(), c["on_stations"].dump(),
                          c["in_transit"].dump(), c["inspection"].dump(), c["conserved"] ? "" : "NOT CONSERVED"});
+      inspection += c["inspection"].get<long>();
     }
     std::cout << "\nInventory (" << report["state_dir"].get<std::string>() << ")\n";
     inventory.print(std::cout);
+    if (inspection > 0) {
+      std::cout << inspection << " parts are held for inspection: a gripper held them when a process died. The cell does "
+                << "not use them again; the journal names each (event 'inspection'). Check them on their station by hand.\n";
+    }
     const auto orders = observer.orders();
     std::cout << "\n" << orders.size() << " orders\n";
     for (const auto& [id, s] : orders) print_progress(s);

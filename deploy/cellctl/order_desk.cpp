@@ -57,6 +57,8 @@ void OrderDesk::tend() {
     }
     if (!why.empty()) {
       if (!o.reason.empty()) why += "; last: " + o.reason;
+      // What the operator does next: the twins wrote to cellctl up's output.
+      why += ". The twins' output is in cellctl up's; fix the cause, then submit the order again under another --order";
       store_.set_order(id, "FAILED", why, 1);
       store_.journal("cellctl", "FAILED", id, why);
       log_("order " + id + " failed: " + why);

@@ -40,9 +40,15 @@ void TwinBindings::forget(int id) {
 }
 
 // A binding lasts when its writer goes (cellctl up restarted): the twin it names may still run.
+// An identity speaks for one order at a time: identities are pooled, and the twin that had it
+// before has ended, so its binding to a new order ends the one before (the next twin of that
+// identity cannot write for the order of the last).
 void TwinBindings::bind(const std::string& order, const std::string& identity) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = identities_.begin(); it != identities_.end();) {
+      it = it->second == identity && it->first != order ? identities_.erase(it) : std::next(it);
+    }
     identities_[order] = identity;
   }
   ++generation_;

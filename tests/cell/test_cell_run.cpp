@@ -243,34 +243,40 @@ TEST_CASE("cell up: a bad order fails alone, one with a subassembly is built, th
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
                         (dir / "up.log").string());
 
-  const int bad = cellctl({"submit", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "--domain", domain,
-                           "--order", "bad", "--out", (dir / "bad").string()},
-                          dir / "bad.log");
-  const std::string bad_log = read_text(dir / "bad.log");
-  INFO(bad_log);
-  CHECK(bad == 2);
-  CHECK(bad_log.find("unknown_link_id.aml:") != std::string::npos);  // file and line
+  {
+    const int bad = cellctl({"submit", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "--domain", domain,
+                             "--order", "bad", "--out", (dir / "bad").string()},
+                            dir / "bad.log");
+    const std::string bad_log = read_text(dir / "bad.log");
+    INFO(bad_log);
+    CHECK(bad == 2);
+    CHECK(bad_log.find("unknown_link_id.aml:") != std::string::npos);  // file and line
+  }
 
   // Shaft and pendulum built aside as one, then inserted whole: every part ends assembled.
-  const int nested = cellctl({"submit", std::string(TEST_DATA_DIR) + "/planning/cranfield-subassembly/cranfield-subassembly.aml",
-                              "--domain", domain, "--order", "nested", "--out", (dir / "nested").string()},
-                             dir / "nested.log");
-  const std::string nested_log = read_text(dir / "nested.log");
-  INFO(nested_log << read_text(dir / "up.log"));
-  CHECK(nested == 0);
-  CHECK(nested_log.find("assembled 9 parts") != std::string::npos);
   {
-    const auto parts = state::CellStore(dir / "state").parts("nested");
-    CHECK(parts.size() == 9);
-    for (const auto& p : parts) {
-      INFO(p.part);
-      CHECK(p.place == state::Place::assembled);
+    const int nested = cellctl({"submit", std::string(TEST_DATA_DIR) + "/planning/cranfield-subassembly/cranfield-subassembly.aml",
+                                "--domain", domain, "--order", "nested", "--out", (dir / "nested").string()},
+                               dir / "nested.log");
+    const std::string nested_log = read_text(dir / "nested.log"), up_log = read_text(dir / "up.log");
+    INFO("what went wrong, from the order's and the cell's logs:\n" << test::error_lines(nested_log) << test::error_lines(up_log));
+    INFO(nested_log << up_log);
+    CHECK(nested == 0);
+    CHECK(nested_log.find("assembled 9 parts") != std::string::npos);
+    {
+      const auto parts = state::CellStore(dir / "state").parts("nested");
+      CHECK(parts.size() == 9);
+      for (const auto& p : parts) {
+        INFO(p.part);
+        CHECK(p.place == state::Place::assembled);
+      }
     }
   }
 
   const int good = cellctl({"submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain", domain,
                             "--order", "good", "--out", (dir / "good").string()},
                            dir / "good.log");
+  INFO("what went wrong:\n" << test::error_lines(read_text(dir / "good.log")));
   INFO(read_text(dir / "good.log") << read_text(dir / "up.log"));
   CHECK(good == 0);
 

@@ -18,6 +18,7 @@
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "deskPubSubTypes.h"
+#include "deploy/cellctl/file_transfer.hpp"
 #include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "tests/support/cell_test.hpp"
@@ -166,7 +167,10 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
   REQUIRE(test::cellctl({"pki", "issue", stale.string(), "buffer-2", "--domain", domain, "--days", "1", "--backdate-days", "2"},
                         dir / "stale.log") == 0);
 
-  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--security", pki.string(), "--real-time-factor", "50",
+  // Security on by the deployment file's key (a folder relative to the file).
+  const fs::path cell = dir / "cell.yaml";
+  std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nsecurity: pki\n";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "50",
                          "--state-dir", (dir / "state").string()},
                         (dir / "up.log").string());
   const auto up_log = [&] { return test::read_text(dir / "up.log"); };
@@ -277,15 +281,19 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
       binder.write(b);
     };
     std::mutex mutex;
-    std::set<std::string> seen;  // orders whose status came
+    std::map<std::string, std::string> seen;  // order -> the message of its last status that came
     dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType> statuses(
         trusted, "cell/orders/status", dds::TopicKind::state, [&](const cell::OrderStatus& s) {
           std::lock_guard<std::mutex> lock(mutex);
-          seen.insert(s.order_id().to_string());
+          seen[s.order_id().to_string()] = s.message().to_string();
         });
     const auto saw = [&](const std::string& order) {
       std::lock_guard<std::mutex> lock(mutex);
       return seen.count(order) > 0;
+    };
+    const auto message_of = [&](const std::string& order) {
+      std::lock_guard<std::mutex> lock(mutex);
+      return seen.count(order) ? seen.at(order) : std::string();
     };
     const auto wait_to_see = [&](const std::string& order) {
       const auto deadline = std::chrono::steady_clock::now() + 20s;
@@ -300,20 +308,59 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     bind("bound-to-1", "twin-1");
     bind("bound-to-2", "twin-2");
     REQUIRE(status.wait_for_readers(1, 10s));
-    for (const std::string order : {"bound-to-1", "bound-later", "bound-to-2"}) {
+    const auto write_status = [&](const std::string& order, const std::string& message) {
       cell::OrderStatus s;
       s.order_id(order);
       s.state(cell::SUBMITTED);
-      s.message("written by twin-2");
+      s.message(message);
       status.write(s);
-    }
+    };
+    for (const std::string order : {"bound-to-1", "bound-later", "bound-to-2"}) write_status(order, "written by twin-2");
     REQUIRE(wait_to_see("bound-to-2"));
     CHECK_FALSE(saw("bound-later"));
     bind("bound-later", "twin-2");
     CHECK(wait_to_see("bound-later"));
     CHECK_FALSE(saw("bound-to-1"));
+
+    // Bound to a new order (identities are pooled), twin-2 speaks for the orders before no
+    // more: its next status of bound-later waits, while the one of its new order comes (one
+    // writer: in the order written).
+    bind("twin-2-next", "twin-2");
+    write_status("bound-later", "after twin-2 moved on");
+    write_status("twin-2-next", "written by twin-2");
+    CHECK(wait_to_see("twin-2-next"));
+    CHECK(message_of("bound-later") == "written by twin-2");
+
+    // Nor do its commands count for another twin's order: the arm answers one for twin-2's
+    // order (no award), and none for twin-1's.
+    std::set<std::string> answered;  // command ids
+    dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
+        trusted, "cell/command_events", dds::TopicKind::events, [&](const cell::CommandEvent& e) {
+          std::lock_guard<std::mutex> lock(mutex);
+          answered.insert(e.command_id().to_string());
+        });
+    dds::Writer<cell::Command, cell::CommandPubSubType> to_arm(as_twin_2, dds::command_topic("arm-1"), dds::TopicKind::events,
+                                                                dds::command_qos());
+    REQUIRE(to_arm.wait_for_readers(1, 10s));
+    for (const std::string order : {"bound-to-1", "twin-2-next"}) {
+      cell::Command c;
+      c.resource_id("arm-1");
+      c.order_id(order);
+      c.operation("release");
+      c.command_id(order + "/release");
+      to_arm.write(c);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    const auto was_answered = [&](const std::string& id) {
+      std::lock_guard<std::mutex> lock(mutex);
+      return answered.count(id) > 0;
+    };
+    while (!was_answered("twin-2-next/release") && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
     INFO(up_log());
+    CHECK(was_answered("twin-2-next/release"));
+    CHECK_FALSE(was_answered("bound-to-1/release"));
     CHECK(test::appears(dir / "up.log", "held a sample on cell/orders/status for 'twin-1'", 10s));
+    CHECK(test::appears(dir / "up.log", "held a sample on cell/commands/arm-1 for 'twin-1'", 10s));
   }
 
   {  // An expired certificate is refused at start, with the date; a foreign CA's by the cell.
@@ -362,7 +409,7 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   std::string yaml = test::read_text(DEFAULT_CELL);
   yaml.replace(yaml.find("max_order_mb: 64"), 16, "max_order_mb: 0.05");
   yaml.replace(yaml.find("orders_per_minute: 6"), 20, "orders_per_minute: 1");
-  yaml.replace(yaml.find("clients: [oem-a, oem-b]"), 23, "clients: [oem-a, oem-b, oem-c]");
+  yaml.replace(yaml.find("clients: [oem-a, oem-b]"), 23, "clients: [oem-a, oem-b, oem-c, oem-d]");
   const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
   std::ofstream(cell) << yaml;
   REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
@@ -402,6 +449,48 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
                 "the order's files pass the desk's limit of 50000 bytes") == 2);
   CHECK(refused("bad", submit("oem-c", std::string(TEST_DATA_DIR) + "/bad/unknown_link_id.aml", "bad"), "unknown_link_id.aml:") == 2);
   CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-c" / "bad"));  // nothing kept of a refused order
+
+  {  // A file whose bytes are not the ones its order names (its SHA-256) is refused, and
+     // nothing of it is kept: oem-d's own client, writing the desk's topics as cellctl does.
+    auto oem_d = dds::make_participant("test-oem-d", {std::stoi(domain), true, {pki, "oem-d"}});
+    std::mutex mutex;
+    std::optional<cell::DeskReply> answer;
+    dds::Reader<cell::DeskReply, cell::DeskReplyPubSubType> replies(
+        oem_d, cellctl::desk_topic("replies", "oem-d"), dds::TopicKind::state, [&](const cell::DeskReply& r) {
+          std::lock_guard<std::mutex> lock(mutex);
+          if (r.submission().to_string() == "tampered") answer = r;
+        });
+    cellctl::ChunkWriter chunks(oem_d, cellctl::desk_topic("files", "oem-d"), dds::TopicKind::events, cellctl::chunk_qos());
+    dds::Writer<cell::OrderRequest, cell::OrderRequestPubSubType> orders(oem_d, cellctl::desk_topic("orders", "oem-d"),
+                                                                         dds::TopicKind::events);
+    REQUIRE(chunks.wait_for_readers(1, 20s));
+    REQUIRE(orders.wait_for_readers(1, 20s));
+    const std::string bytes = cellctl::read_file_bytes(kLego);
+    REQUIRE(cellctl::send_file(chunks, "tampered", "lego-tower.aml", bytes, std::chrono::steady_clock::now() + 20s));
+    REQUIRE(chunks.wait_for_acknowledgments(20s));
+    cell::OrderRequest request;
+    request.submission("tampered");
+    request.request("r1");
+    request.product("lego-tower.aml");
+    cell::FileDigest digest;
+    digest.name("lego-tower.aml");
+    digest.size(bytes.size());
+    digest.sha256(cellctl::sha256_hex(bytes + "changed on the way"));
+    request.files().push_back(digest);
+    REQUIRE(orders.write(request));
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    const auto answered = [&] {
+      std::lock_guard<std::mutex> lock(mutex);
+      return answer;
+    };
+    while (!answered() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+    INFO(test::read_text(dir / "up.log"));
+    REQUIRE(answered());
+    CHECK(answered()->state() == cell::DESK_REFUSED);
+    CHECK(answered()->message().to_string() == "lego-tower.aml: its size or SHA-256 is not what the order says");
+    CHECK(answered()->exit_code() == 2);
+    CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-d" / "tampered"));
+  }
 
   // oem-b's certificate reads its own answers, not oem-a's, nor the cell's order status.
   auto oem_b = dds::make_participant("test-oem-b", {std::stoi(domain), true, {pki, "oem-b"}});

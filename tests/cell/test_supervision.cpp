@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
 
 namespace {
@@ -52,6 +53,12 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
   CHECK(up.wait_for_exit(30s) == 1);
   CHECK(test::read_text(log).find("error: buffer-2 ended 3 times within 60 s, last with exit 137; stopping the cell") !=
         std::string::npos);
+  // The journal keeps the reason for whoever reads the state later.
+  bool journaled = false;
+  for (const auto& e : state::CellStore(dir / "state").journal_since(0)) {
+    journaled |= e.event == "down" && e.detail.find("gave up: buffer-2 ended 3 times within 60 s") != std::string::npos;
+  }
+  CHECK(journaled);
   CHECK(test::children_of(up.pid()).empty());
 }
 

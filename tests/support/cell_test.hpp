@@ -38,6 +38,20 @@ inline int cellctl(std::vector<std::string> args, const std::filesystem::path& l
   return p.wait_for_exit(timeout);
 }
 
+// The lines of a log that say what went wrong ("error: ...", a watchdog's, an exception's),
+// for a failed check to show first: CI shows only the start of a long message.
+inline std::string error_lines(const std::string& log) {
+  std::istringstream lines(log);
+  std::string out;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("error") != std::string::npos || line.find("FAILED") != std::string::npos ||
+        line.find("ABORTED") != std::string::npos || line.find("disappeared") != std::string::npos) {
+      out += line + '\n';
+    }
+  }
+  return out.empty() ? "(no error line)" : out;
+}
+
 // Waits until the text shows up in the file (a process's log).
 inline bool appears(const std::filesystem::path& file, const std::string& text,
                     std::chrono::seconds timeout = std::chrono::seconds(30)) {
