@@ -3,6 +3,7 @@
 
 #include "tests/twin/test_support.hpp"
 #include "twin/planning/assembly_planner.hpp"
+#include "twin/planning/finger_contact.hpp"
 
 namespace {
 
@@ -19,6 +20,31 @@ twin::Plan plan_of(const twin::LoadedProduct& loaded, const twin::PlannerOptions
   return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"), options);
 }
 
+// An L in section, extruded along z: a wall x 0..5 mm, y 0..60 mm, and a lip along its foot,
+// x 0..40 mm, y 0..5 mm; z -20..20 mm. Closed, one piece, as a CAD export would be.
+sim::TriangleMesh l_bracket() {
+  const std::vector<std::array<double, 2>> section{{0, 0}, {0.040, 0}, {0.040, 0.005}, {0.005, 0.005}, {0.005, 0.060}, {0, 0.060}};
+  sim::TriangleMesh mesh;
+  for (const double z : {-0.020, 0.020}) {
+    for (const auto& [x, y] : section) mesh.vertices.emplace_back(x, y, z);
+  }
+  const std::uint32_t n = 6;
+  // The two ends: the L as four triangles (a fan from the inner corner, vertex 3).
+  for (const auto& [a, b] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{{4, 5}, {5, 0}, {0, 1}, {1, 2}}) {
+    mesh.triangles.push_back({3, b, a});
+    mesh.triangles.push_back({3 + n, a + n, b + n});
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::uint32_t j = (i + 1) % n;
+    mesh.triangles.push_back({i, j, j + n});
+    mesh.triangles.push_back({i, j + n, i + n});
+  }
+  mesh.pieces.emplace_back();
+  for (std::uint32_t i = 0; i < 2 * n; ++i) mesh.pieces.back().push_back(i);
+  for (const auto& v : mesh.vertices) mesh.bounds.extend(v);
+  return mesh;
+}
+
 bool has_finding(const twin::Plan& plan, const std::string& kind, const std::string& text) {
   for (const auto& f : plan.findings) {
     if (f.kind == kind && f.message.find(text) != std::string::npos) return true;
@@ -33,11 +59,12 @@ TEST_CASE("grasps: behind the push first, the narrower faces first, never ahead 
   const Eigen::AlignedBox3d box(Vec3(0.092, 0, -0.005), Vec3(0.108, 0.024, 0.005));
   const fb::GripperGeometry gripper;
   const auto grasps = twin::grasps_for(box, at(Vec3(0.1, 0, 0)), -Vec3::UnitY(), gripper);
-  REQUIRE(grasps.size() == 20);  // five sides, two pairs of faces each, two depths
+  REQUIRE(grasps.size() == 30);  // five sides, two pairs of faces each, three depths
   CHECK(grasps[0].label == "across z from above");
   CHECK(grasps[0].opening == Approx(0.010));
   CHECK(grasps[1].label == "across z from above, shallow");
-  CHECK(grasps[2].label == "across x from above");
+  CHECK(grasps[2].label == "across z from above, deep");
+  CHECK(grasps[3].label == "across x from above");
   for (const auto& g : grasps) {
     INFO(g.label);
     const twin::Pose world = at(Vec3(0.1, 0, 0)) * g.gripper;
@@ -52,6 +79,9 @@ TEST_CASE("grasps: behind the push first, the narrower faces first, never ahead 
   // A shallow grasp, a quarter of the way down: 6 mm.
   CHECK((at(Vec3(0.1, 0, 0)) * grasps[1].gripper).translation().isApprox(
       Vec3(0.1, 0.024 + 0.024 + gripper.palm_thickness / 2, 0), 1e-12));
+  // A deep one, to 2 mm above its bottom: 22 mm down, the palm 8 mm above its top.
+  CHECK((at(Vec3(0.1, 0, 0)) * grasps[2].gripper).translation().isApprox(
+      Vec3(0.1, 0.024 + 0.008 + gripper.palm_thickness / 2, 0), 1e-12));
 
   // Pushed along +x: the carriage behind, on -x, comes first; none stands on +x.
   const auto sideways = twin::grasps_for(box, at(Vec3(0.1, 0, 0)), Vec3::UnitX(), gripper);
@@ -115,4 +145,73 @@ TEST_CASE("grasps: a smaller gripper from the deployment file leaves a part it c
   const twin::Plan plan = plan_of(loaded, options);
   CHECK_FALSE(plan.complete);
   CHECK(has_finding(plan, "infeasible", "bushing: no grasp: it is 16.00 mm across at its narrowest, 4.00 mm more than the gripper opens"));
+}
+
+TEST_CASE("grasps: a finger on a face of a concave part's box may close on air, and such a grasp does not hold it",
+          "[planning][grasp]") {
+  const sim::TriangleMesh bracket = l_bracket();
+  const fb::GripperGeometry gripper;
+  std::map<std::string, bool> holds;
+  for (const auto& g : twin::grasps_for(bracket.bounds, twin::Pose::Identity(), -Vec3::UnitY(), gripper)) {
+    holds[g.label] = twin::fingers_touch(bracket, g, gripper, 0.001);
+  }
+  // From above, the fingers reach 30 mm down the 60 mm wall: across x, the one at x = 40 mm
+  // finds nothing but the lip, 25 mm below its tip; across z, both land in the middle of the
+  // box, 15 mm from the wall. From -x, across z, they reach 20 mm in and hold the wall's ends.
+  REQUIRE(holds.count("across x from above"));
+  CHECK_FALSE(holds["across x from above"]);
+  CHECK_FALSE(holds["across x from above, deep"]);
+  CHECK_FALSE(holds["across z from above"]);
+  CHECK(holds["across z from -x"]);
+  // A block is held wherever its box is.
+  sim::TriangleMesh block;
+  for (const double x : {0.0, 0.040}) {
+    for (const double y : {0.0, 0.060}) {
+      for (const double z : {-0.020, 0.020}) block.vertices.emplace_back(x, y, z);
+    }
+  }
+  block.triangles = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1},
+                     {2, 3, 7}, {2, 7, 6}, {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+  for (const auto& v : block.vertices) block.bounds.extend(v);
+  for (const auto& g : twin::grasps_for(block.bounds, twin::Pose::Identity(), -Vec3::UnitY(), gripper)) {
+    INFO(g.label);
+    CHECK(twin::fingers_touch(block, g, gripper, 0.001));
+  }
+}
+
+TEST_CASE("grasps: low walls are held deep, a grasp that closes on air is said before any move, and another taken", "[planning][grasp]") {
+  // The ledge product's enclosure: walls 5 mm high around a cavity, and one 15 mm high. Half
+  // way down its 15 mm box the fingers across its 40 mm would close 2.5 mm above the low
+  // walls: held deep, to 2 mm above its bottom.
+  sim::MeshCache cache;
+  const auto ledge = twin::load_product(test::data("planning/ledge/ledge.aml"), cache);
+  const twin::Plan plan = plan_of(ledge);
+  const auto enclosure = std::find_if(plan.steps.begin(), plan.steps.end(), [&](const auto& s) {
+    return ledge.product.parts()[s.part].name == "enclosure";
+  });
+  REQUIRE(enclosure != plan.steps.end());
+  CHECK(enclosure->trajectory.grasp.label == "across z from above, deep");
+
+  // The L bracket alone on the station: held across x from above, a finger closes on air,
+  // and virtual assembly says so before any move; the planner holds it from -x instead.
+  twin::LoadedProduct alone{twin::Product("bracket", ""), {std::make_shared<sim::TriangleMesh>(l_bracket())}, {}};
+  twin::DigitalPart part;
+  part.id = "bracket";
+  part.name = "bracket";
+  part.final_pose = twin::Pose::Identity();
+  alone.product.add_part(part);
+  twin::AssemblyScene scene(alone);
+  twin::Trajectory down = twin::LinearPathPlanner::straight_insertion(scene, 0, "down", -Vec3::UnitY());
+  const auto grasps = scene.grasps(0, -Vec3::UnitY());
+  const auto on_air = std::find_if(grasps.begin(), grasps.end(), [](const auto& g) { return g.label == "across x from above"; });
+  REQUIRE(on_air != grasps.end());
+  down.hold_by(*on_air);
+  const auto air = scene.simulate(0, down);
+  REQUIRE(air);
+  CHECK(air->phase == "gripping");
+  CHECK(air->member == "finger");
+  const twin::Plan plan_alone = plan_of(alone);
+  REQUIRE(plan_alone.complete);
+  CHECK(scene.holds(0, plan_alone.steps[0].trajectory.grasp));
+  CHECK(plan_alone.steps[0].trajectory.grasp.label.find("from -x") != std::string::npos);
 }

@@ -19,7 +19,7 @@ twin::Pose at_mm(double x, double y, double z) {
 
 // Parts given by their meshes and final poses.
 struct Made {
-  twin::LoadedProduct loaded{twin::Product("made", "made.aml"), {}};
+  twin::LoadedProduct loaded{twin::Product("made", "made.aml"), {}, {}};
   Made& part(const std::string& name, sim::TriangleMesh mesh, const twin::Pose& pose) {
     twin::DigitalPart p;
     p.id = p.name = name;

@@ -45,7 +45,7 @@ TEST_CASE("Cranfield: back first, shaft before pendulum, square pegs before sepa
   for (const char* sequence : {"paper", "search"}) {
     SECTION(sequence) {
       sim::MeshCache cache;
-      twin::LoadedProduct loaded{twin::Product("", ""), {}};
+      twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
       const twin::Plan p = plan(test::product("cranfield/cranfield.aml"), sequence, cache, loaded);
       REQUIRE(p.complete);
       const auto o = order(loaded, p);
@@ -73,7 +73,7 @@ TEST_CASE("Lego tower: bottom-up, and the hanging brick goes in sideways after a
   for (const char* sequence : {"paper", "search"}) {
     SECTION(sequence) {
       sim::MeshCache cache;
-      twin::LoadedProduct loaded{twin::Product("", ""), {}};
+      twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
       const twin::Plan p = plan(test::product("lego-tower/lego-tower.aml"), sequence, cache, loaded);
       REQUIRE(p.complete);
       // Bottom-up: no brick is assembled before one it stands on.
@@ -97,7 +97,7 @@ TEST_CASE("Lego tower: bottom-up, and the hanging brick goes in sideways after a
 
 TEST_CASE("backtracking: the paper heuristic stops where the search planner finishes", "[planning][backtrack]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan paper = plan(test::data("planning/backtrack/backtrack.aml"), "paper", cache, loaded);
   CHECK_FALSE(paper.complete);
   CHECK(order(loaded, paper) == std::vector<std::string>{"base", "cap"});
@@ -112,7 +112,7 @@ TEST_CASE("backtracking: the paper heuristic stops where the search planner fini
 
 TEST_CASE("a product no order can build is reported with what blocks what", "[planning][impossible]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan p = plan(test::data("planning/impossible/impossible.aml"), "search", cache, loaded);
   CHECK_FALSE(p.complete);
   CHECK(has_finding(p, "infeasible", "block: no collision-free path; blocked by shell"));
@@ -120,7 +120,7 @@ TEST_CASE("a product no order can build is reported with what blocks what", "[pl
 
 TEST_CASE("the same input gives the same plan", "[planning][determinism]") {
   sim::MeshCache cache;
-  twin::LoadedProduct a{twin::Product("", ""), {}}, b{twin::Product("", ""), {}};
+  twin::LoadedProduct a{twin::Product("", ""), {}, {}}, b{twin::Product("", ""), {}, {}};
   const twin::Plan first = plan(test::product("lego-tower/lego-tower.aml"), "search", cache, a);
   const twin::Plan second = plan(test::product("lego-tower/lego-tower.aml"), "search", cache, b);
   REQUIRE(first.steps.size() == second.steps.size());
@@ -134,7 +134,7 @@ TEST_CASE("the same input gives the same plan", "[planning][determinism]") {
 
 TEST_CASE("a given order (a twin taking an order up) is followed, and one that cannot be built is not", "[planning][given]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan searched = plan(test::product("cranfield/cranfield.aml"), "search", cache, loaded);
   REQUIRE(searched.complete);
   std::vector<std::string> given = order(loaded, searched);
@@ -163,7 +163,7 @@ TEST_CASE("a given order (a twin taking an order up) is followed, and one that c
 
 TEST_CASE("no straight insertion: OMPL's RRT-Connect finds a path, checked in the collision world", "[planning][ompl]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan linear = plan(test::data("planning/ledge/ledge.aml"), "search", cache, loaded, "linear");
   CHECK_FALSE(linear.complete);
   CHECK(has_finding(linear, "infeasible", "block: no collision-free path"));
@@ -189,7 +189,7 @@ TEST_CASE("no straight insertion: OMPL's RRT-Connect finds a path, checked in th
 TEST_CASE("lipped box: one-piece concave walls go straight down, the wide block goes in before the last wall",
           "[planning][concave]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan p = plan(test::data("planning/lipped-box/lipped-box.aml"), "search", cache, loaded);
   REQUIRE(p.complete);
   const auto o = order(loaded, p);
@@ -219,7 +219,7 @@ TEST_CASE("lipped box: one-piece concave walls go straight down, the wide block 
 
 TEST_CASE("a mesh in millimetres (LengthUnit mm) is placed and planned in metres", "[planning][units]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan p = plan(test::data("planning/units/units.aml"), "search", cache, loaded);
   REQUIRE(p.complete);
   const auto& block = test::part(loaded.product, "block");
@@ -231,7 +231,7 @@ TEST_CASE("a mesh in millimetres (LengthUnit mm) is placed and planned in metres
 TEST_CASE("a COLLADA mesh states its own unit: it is placed as written, and a LengthUnit on it is an error",
           "[planning][units]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan p = plan(test::data("planning/collada/collada.aml"), "search", cache, loaded);
   REQUIRE(p.complete);
   const auto& mesh = *loaded.meshes[*loaded.product.find_part_by_name("block")];
@@ -246,7 +246,7 @@ TEST_CASE("a COLLADA mesh states its own unit: it is placed as written, and a Le
 TEST_CASE("insertion margins: the room each part and its gripper have on the way in, seats left out",
           "[planning][margin]") {
   sim::MeshCache cache;
-  twin::LoadedProduct loaded{twin::Product("", ""), {}};
+  twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   SECTION("Cranfield: every peg has its hole's 0.5 mm of play, and that is under the 1 mm threshold") {
     const twin::Plan p = plan(test::product("cranfield/cranfield.aml"), "search", cache, loaded);
     REQUIRE(p.complete);

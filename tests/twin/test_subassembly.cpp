@@ -76,6 +76,10 @@ TEST_CASE("subassemblies: built aside first, then inserted as one body", "[plann
   REQUIRE(insertion != plan.steps.end());
   CHECK(insertion->part == shaft);
   CHECK(insertion->carried == std::vector<twin::PartIndex>{pendulum});
+  // Gripped by its base: across the shaft's 15 mm, from above (the middle of the whole's box
+  // is air, beside the shaft and high above the pendulum).
+  CHECK(insertion->trajectory.grasp.label == "across z from above");
+  CHECK(insertion->trajectory.grasp.opening == Approx(0.015).margin(1e-6));
   CHECK(twin::step_name(loaded.product, *insertion) == "ShaftPendulum (shaft, pendulum)");
   CHECK(insertion->trajectory.waypoints.back().part.isApprox(parts[shaft].final_pose, 1e-9));
   // Its own steps come before it, built aside: each ends at its final pose moved aside.

@@ -16,7 +16,7 @@ std::unique_ptr<ProductDescription> open_description(const std::filesystem::path
 
 LoadedProduct load_product(const std::filesystem::path& file, sim::MeshCache& cache,
                            const PlacementOptions& options) {
-  LoadedProduct loaded{build_product(*open_description(file)), {}};
+  LoadedProduct loaded{build_product(*open_description(file)), {}, {}};
   for (const auto& part : loaded.product.parts()) {
     if (!part.mesh) {
       loaded.meshes.push_back(nullptr);

@@ -17,6 +17,9 @@ std::unique_ptr<ProductDescription> open_description(const std::filesystem::path
 struct LoadedProduct {
   Product product;
   PartMeshes meshes;
+  // What the gripper holds a part by, in the part's frame, where not its whole mesh: a
+  // subassembly by its base. Empty, or null for a part: its own mesh.
+  PartMeshes held_by;
 };
 
 // Throws DescriptionError for the first part without a mesh: planning needs every part's shape.

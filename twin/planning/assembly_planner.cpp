@@ -202,6 +202,9 @@ class Search {
       if (const auto worst = worst_.find(p); worst != worst_.end() && worst->second.phase == "grasp") {
         why.push_back("no grasp: it is " + millimetres(final_bounds_min(p)) + " across at its narrowest, " +
                       millimetres(worst->second.depth) + " more than the gripper opens");
+      } else if (worst != worst_.end() && worst->second.phase == "gripping") {
+        why.push_back("no grasp holds it: on every pair of faces of its box the gripper opens to, a finger closes on "
+                      "air (the part is concave or tapered there)");
       } else if (worst != worst_.end()) {
         const Collision& c = worst->second;
         const auto& gripper = gripper_blocked_by_[p];

@@ -2,11 +2,16 @@
 
 #include <algorithm>
 
+#include "twin/planning/finger_contact.hpp"
+
 namespace twin {
 namespace {
 
 constexpr double kOnSurface = 1e-4;  // m: a part this close to y = 0 stands on the station
 constexpr double kShortOfSeat = 1e-3;  // m: where insertion margins stop (AssemblyScene::margin)
+// m: a finger holds where the part's surface is this near its pad (a gripper closes that much
+// onto a part that is a little narrower there than its box).
+constexpr double kFingerReach = 1e-3;
 
 Pose translation(const Vec3& t) {
   Pose p = Pose::Identity();
@@ -19,14 +24,18 @@ Pose translation(const Vec3& t) {
 AssemblyScene::AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options, fb::GripperGeometry gripper)
     : product_(product), gripper_(gripper), world_(options) {
   const auto& parts = product.product.parts();
-  for (PartIndex i = 0; i < parts.size(); ++i) {
+  const auto box_of = [&](PartIndex i, const std::shared_ptr<const sim::TriangleMesh>& mesh) {
     Eigen::AlignedBox3d box;
-    if (const auto& mesh = product.meshes[i]) {
+    if (mesh) {
       for (const auto& v : mesh->vertices) box.extend(parts[i].final_pose * v);
     } else {
       box.extend(parts[i].final_pose.translation());
     }
-    bounds_.push_back(box);
+    return box;
+  };
+  for (PartIndex i = 0; i < parts.size(); ++i) {
+    bounds_.push_back(box_of(i, product.meshes[i]));
+    grasp_bounds_.push_back(box_of(i, held_by(i)));
   }
   for (PartIndex i = 0; i < parts.size(); ++i) update_frontier(i);
   // The station's surface: a slab whose top is the assembly surface, y = 0.
@@ -87,7 +96,7 @@ void AssemblyScene::update_frontier(PartIndex part) {
 }
 
 std::vector<Grasp> AssemblyScene::grasps(PartIndex part, const Vec3& direction) const {
-  return grasps_for(bounds_[part], product_.product.parts()[part].final_pose, direction, gripper_);
+  return grasps_for(grasp_bounds_[part], product_.product.parts()[part].final_pose, direction, gripper_);
 }
 
 HeldPart AssemblyScene::hold(PartIndex part, const Grasp& grasp) const {
@@ -108,9 +117,23 @@ std::optional<Collision> AssemblyScene::collision_at(const sim::MovingBody& body
   return std::nullopt;
 }
 
+const std::shared_ptr<const sim::TriangleMesh>& AssemblyScene::held_by(PartIndex part) const {
+  const auto& held = product_.held_by;
+  return part < held.size() && held[part] ? held[part] : product_.meshes[part];
+}
+
+bool AssemblyScene::holds(PartIndex part, const Grasp& grasp) const {
+  const auto& mesh = held_by(part);
+  if (!mesh) return true;
+  const auto key = std::make_pair(part, grasp.label);
+  if (const auto known = holds_.find(key); known != holds_.end()) return known->second;
+  return holds_[key] = fingers_touch(*mesh, grasp, gripper_, kFingerReach);
+}
+
 std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {
   const auto& w = trajectory.waypoints;
   if (w.empty()) return std::nullopt;
+  if (!holds(part, trajectory.grasp)) return Collision{"", "finger", 0, "gripping"};
   const HeldPart held = hold(part, trajectory.grasp);
   if (w.front().holding) {
     if (auto c = collision_at(held.with_arm, w.front().part, w.front().phase)) return c;

@@ -18,7 +18,8 @@ struct Collision {
   std::string with;     // a part's name or "station"
   std::string member;   // what hit it: "part", "finger", "palm", "carriage"
   double depth = 0;     // m
-  std::string phase;    // of the trajectory; "grasp": no grasp fits the part (depth: by how much)
+  std::string phase;    // of the trajectory; "grasp": no grasp fits the part (depth: by how much);
+                        // "gripping": a finger of the grasp closes on air
 };
 
 // The least room a part had on its way in: how near it, or the gripper holding it, came to
@@ -58,14 +59,19 @@ class AssemblyScene {
   const std::set<PartIndex>& frontier() const { return frontier_; }
   bool stands_on_surface(PartIndex part) const;
 
-  // The gripper's grasps on the part for a push along `direction`, best first (grasp.hpp).
+  // The gripper's grasps on the part (on what it holds it by) for a push along `direction`,
+  // best first (grasp.hpp).
   std::vector<Grasp> grasps(PartIndex part, const Vec3& direction) const;
   // The part in the gripper, held by `grasp`.
   HeldPart hold(PartIndex part, const Grasp& grasp) const;
   std::optional<Collision> collision_at(const sim::MovingBody& body, const Pose& pose, const std::string& phase) const;
 
+  // Whether the grasp's fingers both have the part's surface at their pads (a finger on a
+  // face of a concave part's box may close on air: finger_contact.hpp).
+  bool holds(PartIndex part, const Grasp& grasp) const;
   // Runs the trajectory in the collision world: the held part with the arm, then the arm
-  // alone once it has let go. The first collision, or nothing.
+  // alone once it has let go. The first collision, or nothing; a grasp that does not hold
+  // the part is one of phase "gripping", before any move.
   std::optional<Collision> simulate(PartIndex part, const Trajectory& trajectory) const;
   // Runs the trajectory with its own grasp, then with the part's other grasps for its
   // direction, and keeps the first that is free of collisions through insertion and
@@ -94,11 +100,17 @@ class AssemblyScene {
   bool linked_to_assembled(PartIndex part) const;
   void update_frontier(PartIndex part);
 
+  // What the gripper holds the part by (LoadedProduct::held_by).
+  const std::shared_ptr<const sim::TriangleMesh>& held_by(PartIndex part) const;
+
   std::vector<Eigen::AlignedBox3d> bounds_;
+  std::vector<Eigen::AlignedBox3d> grasp_bounds_;  // of what the gripper holds each part by
   Eigen::AlignedBox3d assembled_bounds_;
   std::set<PartIndex> frontier_;
   std::map<PartIndex, sim::BodyId> bodies_;
   std::map<sim::BodyId, std::string> names_;
+  // holds(), by part and grasp label (a label names one grasp of a part's box).
+  mutable std::map<std::pair<PartIndex, std::string>, bool> holds_;
 };
 
 }  // namespace twin

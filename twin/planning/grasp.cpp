@@ -1,11 +1,14 @@
 #include "twin/planning/grasp.hpp"
 
 #include <algorithm>
+#include <iterator>
 
 namespace twin {
 namespace {
 
 const char* const kAxis[] = {"x", "y", "z"};
+// m the fingertips of a deep grasp stay short of the part's far side (and of what it sits on).
+constexpr double kDeepGraspClearance = 0.002;
 
 std::string side_name(int axis, double sign) {
   if (axis == 1) return sign > 0 ? "above" : "below";
@@ -49,14 +52,19 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
       world.linear().col(1) = y;
       world.linear().col(2) = x.cross(y);
       const std::string label = std::string("across ") + kAxis[close] + " from " + side_name(side_axis, side_sign);
-      // Half-way into the part, then a quarter (out of a bore the part sinks into).
+      // Half-way into the part, then a quarter (out of a bore the part sinks into), then as
+      // deep as the fingers and the part allow (low walls of a concave part the fingers would
+      // miss half-way down: finger_contact.hpp).
       const double half = std::min(gripper.finger_length, depth / 2), quarter = std::min(gripper.finger_length, depth / 4);
-      for (const bool shallow : {false, true}) {
-        if (shallow && quarter == half) break;
+      const double deep = std::min(gripper.finger_length, depth - kDeepGraspClearance);
+      const std::pair<double, const char*> reaches[] = {{half, ""}, {quarter, ", shallow"}, {deep, ", deep"}};
+      for (std::size_t r = 0; r < std::size(reaches); ++r) {
+        const auto [reach, variant] = reaches[r];
+        if (r == 1 && reach == half) continue;
+        if (r == 2 && reach <= half + kDeepGraspClearance) continue;
         // The palm stands off the part's face so that the fingertips reach `reach` into it.
-        const double reach = shallow ? quarter : half;
         world.translation() = box.center() + y * (depth / 2 + gripper.finger_length - reach + gripper.palm_thickness / 2);
-        out.push_back({final_pose.inverse() * world, size[close], label + (shallow ? ", shallow" : "")});
+        out.push_back({final_pose.inverse() * world, size[close], label + variant});
       }
     }
   }

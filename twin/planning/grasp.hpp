@@ -1,7 +1,7 @@
 #pragma once
 // How the arm's two-finger parallel gripper holds a part: its fingers on a pair of opposite
 // faces of the part's box (across a cylinder, its diameter), the carriage on one side. A part
-// pushed along a direction has up to twenty grasps; the planner takes the first one that is
+// pushed along a direction has up to thirty grasps; the planner takes the first one that is
 // free of collisions through insertion and retreat.
 
 #include <string>
@@ -23,7 +23,8 @@ struct Grasp {
 // the push, then above, then beside; never ahead of it. For each side, the narrower pair of
 // faces first; a pair wider than the gripper opens is left out. The fingers reach half-way
 // into the part, and in a "shallow" grasp after it a quarter of the way, so that they stay
-// out of the bore the part goes into.
+// out of the bore the part goes into; in a "deep" one last as far as they are long, to 2 mm
+// short of the part's far side (the low walls of a tray).
 std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_pose, const Vec3& direction,
                               const fb::GripperGeometry& gripper);
 

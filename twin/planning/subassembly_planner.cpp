@@ -25,7 +25,7 @@ DigitalPart alone(DigitalPart part) {
 
 // The subassembly as a product of its own, built beside the product on the station.
 LoadedProduct subassembly_product(const LoadedProduct& product, const Subassembly& s, const Vec3& aside) {
-  LoadedProduct out{empty_like(product.product, product.product.name() + "/" + s.name), {}};
+  LoadedProduct out{empty_like(product.product, product.product.name() + "/" + s.name), {}, {}};
   std::map<PartIndex, PartIndex> index;
   for (PartIndex m : s.members) {
     DigitalPart part = alone(product.product.parts()[m]);
@@ -57,7 +57,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
                                std::vector<const Subassembly*>& unit_of, std::vector<PartIndex>& origin,
                                std::vector<std::string>& conflicts) {
   const auto& parts = product.product.parts();
-  LoadedProduct out{empty_like(product.product, product.product.name()), {}};
+  LoadedProduct out{empty_like(product.product, product.product.name()), {}, {}};
   std::map<PartIndex, const Subassembly*> member_of;
   for (const auto& s : subassemblies) {
     for (PartIndex m : s.members) member_of[m] = &s;
@@ -68,6 +68,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
     if (it == member_of.end()) {
       out.product.add_part(alone(parts[p]));
       out.meshes.push_back(product.meshes[p]);
+      out.held_by.push_back(nullptr);
       unit_of.push_back(nullptr);
       origin.push_back(p);
       continue;
@@ -90,6 +91,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
     id_of_unit[&s] = unit.id;
     out.product.add_part(std::move(unit));
     out.meshes.push_back(merged_mesh(product, s.members));
+    out.held_by.push_back(product.meshes[p]);  // gripped by its base, whose frame is the unit's
     unit_of.push_back(&s);
     origin.push_back(p);
   }

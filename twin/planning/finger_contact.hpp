@@ -1,0 +1,17 @@
+#pragma once
+// Whether a grasp holds its part: a grasp sits on a pair of opposite faces of the part's box
+// (grasp.hpp), and on a concave part (an L, a bracket, a lipped wall) or a tapered one a face
+// of the box may be air where a finger lands. A finger holds where the part's surface comes
+// within `within` of its pad, the side that faces the part.
+
+#include "services/node/gripper.hpp"
+#include "sim/mesh/triangle_mesh.hpp"
+#include "twin/planning/grasp.hpp"
+
+namespace twin {
+
+// True when both fingers of `grasp` have a triangle of `part` (in the part's frame) within
+// `within` (m) of their pads.
+bool fingers_touch(const sim::TriangleMesh& part, const Grasp& grasp, const fb::GripperGeometry& gripper, double within);
+
+}  // namespace twin
