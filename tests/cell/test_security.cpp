@@ -21,6 +21,7 @@
 #include "deploy/cellctl/file_transfer.hpp"
 #include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
+#include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
 
 namespace {
@@ -404,12 +405,13 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("order-desk");
   const std::string domain = "226";
-  // The default cell, with a desk that takes 50 kB (the Lego tower, not Cranfield) and one
-  // order a minute per client.
+  // The default cell, with a desk that takes 50 kB (the Lego tower, not Cranfield), one
+  // order a minute per client and one order under way in the cell.
   std::string yaml = test::read_text(DEFAULT_CELL);
   yaml.replace(yaml.find("max_order_mb: 64"), 16, "max_order_mb: 0.05");
   yaml.replace(yaml.find("orders_per_minute: 6"), 20, "orders_per_minute: 1");
-  yaml.replace(yaml.find("clients: [oem-a, oem-b]"), 23, "clients: [oem-a, oem-b, oem-c, oem-d]");
+  yaml.replace(yaml.find("max_orders: 4"), 13, "max_orders: 1");
+  yaml.replace(yaml.find("clients: [oem-a, oem-b]"), 23, "clients: [oem-a, oem-b, oem-c, oem-d, oem-e]");
   const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
   std::ofstream(cell) << yaml;
   REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
@@ -491,6 +493,12 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
     CHECK(answered()->exit_code() == 2);
     CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-d" / "tampered"));
   }
+
+  // An order under way in the cell (one its desk did not take: no twin of the desk runs it)
+  // makes the cell full at one: oem-e's order is refused with the reason, and the desk stays.
+  state::CellStore(dir / "state").set_order("placed-elsewhere", "PHYSICAL_ASSEMBLY");
+  CHECK(refused("busy", submit("oem-e", kLego, "busy"), "the cell has 1 orders under way, its limit; try again later") == 1);
+  CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-e" / "busy"));
 
   // oem-b's certificate reads its own answers, not oem-a's, nor the cell's order status.
   auto oem_b = dds::make_participant("test-oem-b", {std::stoi(domain), true, {pki, "oem-b"}});

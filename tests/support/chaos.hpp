@@ -66,6 +66,7 @@ inline std::vector<std::string> processes_on_domain(int domain) {
   for (const auto& entry : std::filesystem::directory_iterator("/proc")) {
     const std::string name = entry.path().filename().string();
     if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (name == std::to_string(::getpid())) continue;  // bench_chaos --domain N itself
     std::ifstream in(entry.path() / "cmdline", std::ios::binary);
     std::vector<std::string> args;
     for (std::string a; std::getline(in, a, '\0');) args.push_back(a);

@@ -1,7 +1,6 @@
 #include "twin/planning/grasp.hpp"
 
 #include <algorithm>
-#include <iterator>
 
 namespace twin {
 namespace {
@@ -57,15 +56,14 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
       // miss half-way down: finger_contact.hpp).
       const double half = std::min(gripper.finger_length, depth / 2), quarter = std::min(gripper.finger_length, depth / 4);
       const double deep = std::min(gripper.finger_length, depth - kDeepGraspClearance);
-      const std::pair<double, const char*> reaches[] = {{half, ""}, {quarter, ", shallow"}, {deep, ", deep"}};
-      for (std::size_t r = 0; r < std::size(reaches); ++r) {
-        const auto [reach, variant] = reaches[r];
-        if (r == 1 && reach == half) continue;
-        if (r == 2 && reach <= half + kDeepGraspClearance) continue;
+      const auto add = [&](double reach, const char* variant) {
         // The palm stands off the part's face so that the fingertips reach `reach` into it.
         world.translation() = box.center() + y * (depth / 2 + gripper.finger_length - reach + gripper.palm_thickness / 2);
         out.push_back({final_pose.inverse() * world, size[close], label + variant});
-      }
+      };
+      add(half, "");
+      if (quarter < half) add(quarter, ", shallow");
+      if (deep > half + kDeepGraspClearance) add(deep, ", deep");
     }
   }
   return out;
