@@ -376,7 +376,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
         if (const std::string why = supervisor.tend(); !why.empty()) throw std::runtime_error(why);
         if (std::chrono::steady_clock::now() > deadline) wait_for_cell(cell, observer, 0ms);  // throws naming the missing
       }
-    } catch (...) {
+    } catch (const std::exception& e) {
+      store.journal("cellctl", "down", "", std::string("gave up: ") + e.what());
       fs::remove(pid_file(cell.domain));
       throw;
     }

@@ -57,8 +57,9 @@ void OrderDesk::tend() {
     }
     if (!why.empty()) {
       if (!o.reason.empty()) why += "; last: " + o.reason;
-      // What the operator does next: the twins wrote to cellctl up's output.
-      why += ". The twins' output is in cellctl up's; fix the cause, then submit the order again under another --order";
+      // What to do next (the twins wrote to cellctl up's output, which the cell's operator has).
+      why += ". The twins' output is in the cell's log (cellctl up); once the cause is fixed, submit the order again "
+             "under another id";
       store_.set_order(id, "FAILED", why, 1);
       store_.journal("cellctl", "FAILED", id, why);
       log_("order " + id + " failed: " + why);

@@ -36,10 +36,18 @@ void TwinIdentities::give_back(const std::string& identity) {
 
 void TwinIdentities::bind(const std::string& order, const std::string& identity) {
   if (!secure_) return;
+  // The identity's binding to its last order ends (the readers end it too as this one comes,
+  // dds::TwinBindings): a reader that joins later must not get both, in either order.
+  if (const auto last = bound_.find(identity); last != bound_.end() && last->second != order) {
+    cell::TwinBinding before;
+    before.order_id(last->second);
+    writer_->bindings.unregister(before);
+  }
   cell::TwinBinding b;
   b.order_id(order);
   b.identity(identity);
   if (!writer_->bindings.write(b)) throw std::runtime_error("cannot bind order " + order + " to its twin " + identity);
+  bound_[identity] = order;
 }
 
 Twin TwinIdentities::start(const std::string& order, const std::vector<std::string>& argv, const std::string& stdout_to) {

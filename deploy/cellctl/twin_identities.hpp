@@ -6,6 +6,7 @@
 // Without security: no identities, no bindings.
 
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,6 +43,7 @@ class TwinIdentities {
   struct Writer;
   bool secure_;
   std::deque<std::string> free_;  // the longest free first: a name just given back is taken last
+  std::map<std::string, std::string> bound_;  // identity -> the order it was last bound to
   std::unique_ptr<Writer> writer_;
 };
 

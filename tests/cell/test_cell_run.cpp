@@ -377,7 +377,10 @@ TEST_CASE("a resource that dies during an order: the twin fails it with the reas
   const fs::path dir = scratch("robot-dies");
   const std::string domain = "191", bin = fs::path(TWIN_EXE).parent_path().string();
   test::ChildProcess sim({bin + "/cell-sim", "--domain", domain, "--real-time-factor", "20"}, (dir / "sim.log").string());
-  test::ChildProcess station({bin + "/station", "--domain", domain, "--lease", "3"}, (dir / "station.log").string());
+  // Its dock beside its table, as in the deployment files (the default, its own place, is
+  // where the product stands: virtual assembly finds the parts put down there in the way).
+  test::ChildProcess station({bin + "/station", "--domain", domain, "--lease", "3", "--dock", "0.6", "0", "0"},
+                             (dir / "station.log").string());
   test::ChildProcess robot({bin + "/mobile-robot", "--domain", domain, "--lease", "3"}, (dir / "robot.log").string());
   test::ChildProcess buffer({bin + "/buffer", "--domain", domain, "--id", "buffer-1", "--position", "2", "0", "0",
                              "--stock", "Brick2x4=20", "--stock", "Brick2x2=20", "--lease", "3"},

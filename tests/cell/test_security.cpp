@@ -296,6 +296,12 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
       std::lock_guard<std::mutex> lock(mutex);
       return seen.count(order) ? seen.at(order) : std::string();
     };
+    std::set<std::string> answered;  // command ids; made first, to match the arm's events early
+    dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
+        trusted, "cell/command_events", dds::TopicKind::events, [&](const cell::CommandEvent& e) {
+          std::lock_guard<std::mutex> lock(mutex);
+          answered.insert(e.command_id().to_string());
+        });
     const auto wait_to_see = [&](const std::string& order) {
       const auto deadline = std::chrono::steady_clock::now() + 20s;
       while (!saw(order) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
@@ -327,6 +333,13 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     // more: its next status of bound-later waits, while the one of its new order comes (one
     // writer: in the order written).
     bind("twin-2-next", "twin-2");
+    // The binding and the statuses come from two writers: the status once the binding is in.
+    const auto bindings = dds::twin_bindings(trusted);
+    for (const auto until = std::chrono::steady_clock::now() + 20s;
+         bindings->identity_of("bound-later") && std::chrono::steady_clock::now() < until;) {
+      std::this_thread::sleep_for(20ms);
+    }
+    REQUIRE_FALSE(bindings->identity_of("bound-later"));
     write_status("bound-later", "after twin-2 moved on");
     write_status("twin-2-next", "written by twin-2");
     CHECK(wait_to_see("twin-2-next"));
@@ -334,12 +347,6 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
 
     // Nor do its commands count for another twin's order: the arm answers one for twin-2's
     // order (no award), and none for twin-1's.
-    std::set<std::string> answered;  // command ids
-    dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType> events(
-        trusted, "cell/command_events", dds::TopicKind::events, [&](const cell::CommandEvent& e) {
-          std::lock_guard<std::mutex> lock(mutex);
-          answered.insert(e.command_id().to_string());
-        });
     dds::Writer<cell::Command, cell::CommandPubSubType> to_arm(as_twin_2, dds::command_topic("arm-1"), dds::TopicKind::events,
                                                                 dds::command_qos());
     REQUIRE(to_arm.wait_for_readers(1, 10s));

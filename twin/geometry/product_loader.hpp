@@ -18,7 +18,8 @@ struct LoadedProduct {
   Product product;
   PartMeshes meshes;
   // What the gripper holds a part by, in the part's frame, where not its whole mesh: a
-  // subassembly by its base. Empty, or null for a part: its own mesh.
+  // subassembly by its base, whose triangles come first in the part's mesh
+  // (merged_mesh). Empty, or null for a part: its own mesh.
   PartMeshes held_by;
 };
 

@@ -452,9 +452,21 @@ void OrderOrchestrator::start_physical_when_hired() {
 
 std::vector<Trajectory> OrderOrchestrator::candidates(std::size_t step) const {
   std::vector<Trajectory> out;
-  for (const auto& attempt : plan_.steps[step].failed) out.push_back(attempt.trajectory);
+  for (const auto& attempt : plan_.steps[step].failed) {
+    // One that no grasp holds is not tried: cell-sim moves the part and the gripper as one.
+    if (attempt.collision && attempt.collision->phase == "gripping") continue;
+    out.push_back(attempt.trajectory);
+  }
   out.push_back(plan_.steps[step].trajectory);
   return out;
+}
+
+// The robot puts a part down at the station's dock at the height it has in the product,
+// turned as it goes in (`start`: where its trajectory starts, in the cell).
+Pose OrderOrchestrator::at_dock(const std::string& station, PartIndex part, const Pose& start) const {
+  const Numbers& dock = places_.at(station).dock;
+  const double height = at(station, product_.product.parts()[part].final_pose).translation().y();
+  return with_translation(start, dock[0], height, dock[2]);
 }
 
 Pose OrderOrchestrator::at(const std::string& station, const Pose& pose) const {
@@ -488,10 +500,19 @@ const SubassemblyPlan* OrderOrchestrator::subassembly_of(const PlanStep& step) c
   return nullptr;
 }
 
-double OrderOrchestrator::above_asides(const PlanStep& step, const Pose& pose) const {
+double OrderOrchestrator::carry_height(std::size_t index, const Pose& pose) const {
   constexpr double kClearance = 0.02;  // m
+  const PlanStep& step = plan_.steps[index];
   double top = -std::numeric_limits<double>::infinity();
   for (const auto& unit : plan_.subassemblies) top = std::max(top, final_bounds(product_, unit.members).max().y() + unit.aside.y());
+  // The parts in the product already (a carry at the height its trajectory starts went
+  // through the tower it was to go on).
+  for (std::size_t i = 0; i < index; ++i) {
+    if (!plan_.steps[i].subassembly.empty()) continue;  // built aside: the asides' tops above
+    std::vector<PartIndex> in_place{plan_.steps[i].part};
+    in_place.insert(in_place.end(), plan_.steps[i].carried.begin(), plan_.steps[i].carried.end());
+    top = std::max(top, final_bounds(product_, in_place).max().y());
+  }
   if (!std::isfinite(top)) return top;
   // How far the moving parts reach below `pose`, turned as it is.
   const Pose& base = product_.product.parts()[step.part].final_pose;
@@ -531,18 +552,23 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   const std::string& scene = settings_.order_id;
   const auto& w = t.waypoints;
   const MeshRef& mesh = *product_.product.parts()[part].mesh;
-  actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at(virtual_station_, w.front().part)}), {0, 0, 0},
-                                              false, mesh.file.string(), scene, mesh.scale)});
-  const Pose grasp = at(virtual_station_, w.front().gripper);
+  // Where the robot puts it down, and carried from there as the cell's arm will carry it
+  // (plan_physical): the carry is checked too, not only the trajectory.
+  const Pose start = at(virtual_station_, w.front().part), standing = at_dock(virtual_station_, part, start);
+  const Pose grip = w.front().part.inverse() * w.front().gripper;
+  actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({standing}), {0, 0, 0}, false, mesh.file.string(), scene,
+                                              mesh.scale)});
   const auto boxes = fb::gripper_boxes(settings_.gripper, t.grasp.opening);
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const Vec3& h = boxes[i].half_extents;
-    actions_.push_back({Action::sim, sim_.spawn(gripper[i], fb::pose_numbers(grasp * boxes[i].pose), {h.x(), h.y(), h.z()},
-                                                false, "", scene)});
+    actions_.push_back({Action::sim, sim_.spawn(gripper[i], fb::pose_numbers(standing * grip * boxes[i].pose),
+                                                {h.x(), h.y(), h.z()}, false, "", scene)});
   }
   spawned_.insert(body);
   spawned_.insert(gripper.begin(), gripper.end());
   std::vector<Pose> holding, retreat;
+  const double least = carry_height(step, w.front().part) + places_.at(virtual_station_).position[1];
+  for (const Pose& p : lift_over(standing, start, least)) holding.push_back(p * grip);
   for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
   // The palm leads; the fingers, the carriage and (while held) the part go with it.
@@ -589,7 +615,7 @@ void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t
   }
   spawned_.insert(gripper.begin(), gripper.end());
   std::vector<Pose> holding, retreat;
-  const double least = above_asides(unit_step, w.front().part) + places_.at(virtual_station_).position[1];
+  const double least = carry_height(step, w.front().part) + places_.at(virtual_station_).position[1];
   for (const Pose& p : lift_over(standing, at(virtual_station_, w.front().part), least)) holding.push_back(p * grip);
   for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
@@ -723,7 +749,6 @@ void OrderOrchestrator::plan_physical() {
                                                                   (resume.aside.empty() ? "" : std::to_string(resume.aside.size()) + " built aside, ") +
                                                                   std::to_string(resume.delivered.size()) + " at the dock)"),
          0);
-  const Numbers& dock = places_.at(station_).dock;
   // A part set aside (or given back) by the earlier attempt leaves the scene; a new one comes.
   for (const auto& body : resume.used) {
     if (!resume.placed.count(body) && !resume.delivered.count(body)) {
@@ -765,8 +790,8 @@ void OrderOrchestrator::plan_physical() {
     steps.push_back(i);
     if (const std::string* delivered = body_in(resume.delivered, body)) {  // at the dock, where a robot put it down
       body = *delivered;
-      const Pose at_dock = with_translation(final_pose, dock[0], final_pose.translation().y(), dock[2]);
-      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at_dock}), {0, 0, 0}, false, mesh, "", scale)});
+      const Pose down = at_dock(station_, step.part, at(station_, step.trajectory.waypoints.front().part));
+      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({down}), {0, 0, 0}, false, mesh, "", scale)});
       spawned_.insert(body);
       fetches.push_back("delivered/" + body);
       delivered_.insert(fetches.back());
@@ -807,8 +832,7 @@ void OrderOrchestrator::plan_physical() {
       for (const auto& body : moved) actions_.push_back({Action::command, command(arm_, "disconnect", body)});
     } else {
       actions_.push_back({Action::await_delivery, {{"command_id", fetches[k]}}});
-      const double height = at(station_, product_.product.parts()[step.part].final_pose).translation().y();
-      standing = with_translation(start, dock[0], height, dock[2]);
+      standing = at_dock(station_, step.part, start);
     }
     // Carried up from where it stands, over to where the trajectory starts, then along it.
     Data take = command(arm_, "grip", bodies[k]);
@@ -817,7 +841,7 @@ void OrderOrchestrator::plan_physical() {
     take["carried"] = fb::join_names({moved.begin() + 1, moved.end()});
     actions_.push_back({Action::command, take});
     std::vector<Pose> holding, retreat;
-    const double least = above_asides(step, w.front().part) + places_.at(station_).position[1];
+    const double least = carry_height(steps[k], w.front().part) + places_.at(station_).position[1];
     for (const Pose& p : lift_over(standing, start, least)) holding.push_back(p * grip);
     for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(station_, w[i].gripper));
     add_arm_moves(moved, holding, retreat, unit && !inserts_unit(step) ? unit->name : "");

@@ -181,9 +181,13 @@ class OrderOrchestrator : public fb::BasicBlock {
   std::string physical_body(PartIndex part) const;
   // The subassembly that `step` builds aside or inserts; nullptr for a single part's step.
   const SubassemblyPlan* subassembly_of(const PlanStep& step) const;
-  // The least height (product frame) at which `step`'s part, at `pose` turned, and what it
-  // carries clear every subassembly built aside; -inf when there is none.
-  double above_asides(const PlanStep& step, const Pose& pose) const;
+  // Where the robot puts `part` down at the station's dock (in the cell; `start`: where its
+  // trajectory starts there).
+  Pose at_dock(const std::string& station, PartIndex part, const Pose& start) const;
+  // The least height (product frame) at which the part of step `index`, at `pose` turned, and
+  // what it carries are carried over what stands: the parts its steps before put in the
+  // product, and every subassembly built aside; -inf when nothing stands.
+  double carry_height(std::size_t index, const Pose& pose) const;
   // Where `part` stands in its subassembly built aside, in the product's frame.
   Pose aside_pose(PartIndex part, const SubassemblyPlan& unit) const;
   std::map<std::string, int> parts_per_type() const;

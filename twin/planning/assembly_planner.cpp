@@ -58,7 +58,7 @@ class Search {
 
  private:
   const std::string& name(PartIndex p) const { return product_.product.parts()[p].name; }
-  double final_bounds_min(PartIndex p) const { return scene_.final_bounds(p).sizes().minCoeff(); }
+  double grasp_bounds_min(PartIndex p) const { return scene_.grasp_bounds(p).sizes().minCoeff(); }
 
   // Depth-first: returns true once every part is in.
   bool extend() {
@@ -200,7 +200,7 @@ class Search {
       const auto& blockers = blocked_by_[p];
       std::vector<std::string> why;
       if (const auto worst = worst_.find(p); worst != worst_.end() && worst->second.phase == "grasp") {
-        why.push_back("no grasp: it is " + millimetres(final_bounds_min(p)) + " across at its narrowest, " +
+        why.push_back("no grasp: it is " + millimetres(grasp_bounds_min(p)) + " across at its narrowest, " +
                       millimetres(worst->second.depth) + " more than the gripper opens");
       } else if (worst != worst_.end() && worst->second.phase == "gripping") {
         why.push_back("no grasp holds it: on every pair of faces of its box the gripper opens to, a finger closes on "
@@ -234,6 +234,13 @@ class Search {
     // Collisions met on the way to the plan, and how each was resolved.
     for (const auto& step : plan_.steps) {
       for (const auto& a : step.failed) {
+        if (a.collision->phase == "gripping") {
+          plan_.findings.push_back({"grasp",
+                                    name(step.part) + " (" + a.trajectory.label + "): no grasp for this direction holds "
+                                        "it (a finger closes on air on each); resolved by " + step.trajectory.label,
+                                    {name(step.part)}});
+          continue;
+        }
         plan_.findings.push_back({"collision",
                                   name(step.part) + " (" + a.trajectory.label + "): " + a.collision->member + " hit " +
                                       a.collision->with + " while " + a.collision->phase + ", " +

@@ -127,7 +127,14 @@ bool AssemblyScene::holds(PartIndex part, const Grasp& grasp) const {
   if (!mesh) return true;
   const auto key = std::make_pair(part, grasp.label);
   if (const auto known = holds_.find(key); known != holds_.end()) return known->second;
-  return holds_[key] = fingers_touch(*mesh, grasp, gripper_, kFingerReach);
+  bool ok = fingers_touch(*mesh, grasp, gripper_, kFingerReach);
+  // Held by its base, a subassembly's other members (its mesh after the base's triangles)
+  // go with the gripper: it must not stand in them.
+  const auto& whole = product_.meshes[part];
+  if (ok && whole && whole != mesh) {
+    ok = gripper_clear_of(*whole, mesh->triangles.size(), grasp, gripper_, world_.options().contact_tolerance);
+  }
+  return holds_[key] = ok;
 }
 
 std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {
@@ -147,20 +154,26 @@ std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajector
 }
 
 std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajectory& trajectory) const {
-  std::vector<Grasp> all = grasps(part, trajectory.direction);
+  const std::vector<Grasp> all = grasps(part, trajectory.direction);
   if (all.empty()) {
     // Narrower than the gripper opens on no pair of faces: by how much, at the narrowest.
-    return Collision{"", "gripper", final_bounds(part).sizes().minCoeff() - gripper_.max_opening, "grasp"};
+    return Collision{"", "gripper", grasp_bounds(part).sizes().minCoeff() - gripper_.max_opening, "grasp"};
   }
-  const Grasp own = trajectory.grasp;
+  // The grasps that hold the part, its own first; where none does, it keeps its own.
+  std::vector<Grasp> holding;
+  if (holds(part, trajectory.grasp)) holding.push_back(trajectory.grasp);
+  for (const Grasp& g : all) {
+    if (g.label != trajectory.grasp.label && holds(part, g)) holding.push_back(g);
+  }
+  if (holding.empty()) return Collision{"", "finger", 0, "gripping"};
+  trajectory.hold_by(holding.front());
   std::optional<Collision> first = simulate(part, trajectory);
   if (!first || first->member == "part") return first;  // no other grasp helps a part that hits
-  for (const Grasp& g : all) {
-    if (g.label == own.label) continue;
-    trajectory.hold_by(g);
+  for (std::size_t i = 1; i < holding.size(); ++i) {
+    trajectory.hold_by(holding[i]);
     if (!simulate(part, trajectory)) return std::nullopt;
   }
-  trajectory.hold_by(own);
+  trajectory.hold_by(holding.front());
   return first;
 }
 

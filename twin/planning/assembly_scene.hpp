@@ -51,6 +51,8 @@ class AssemblyScene {
 
   // The part's bounding box in the finished product.
   const Eigen::AlignedBox3d& final_bounds(PartIndex part) const { return bounds_[part]; }
+  // The box of what the gripper holds the part by, where its grasps sit (LoadedProduct::held_by).
+  const Eigen::AlignedBox3d& grasp_bounds(PartIndex part) const { return grasp_bounds_[part]; }
   // The assembled parts' bounding box (empty when nothing is assembled).
   const Eigen::AlignedBox3d& assembled_bounds() const { return assembled_bounds_; }
   // Unassembled parts the links allow next: standing on the station's surface (which holds

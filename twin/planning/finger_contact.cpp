@@ -10,36 +10,49 @@ namespace {
 
 using Kernel = CGAL::Simple_cartesian<double>;
 
-Kernel::Point_3 point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+// The part's vertices in the gripper's frame: the fingers close along x, their inner faces at
+// +-opening/2, and reach down along -y from the palm (services/node/gripper.hpp).
+std::vector<Eigen::Vector3d> in_gripper_frame(const sim::TriangleMesh& part, const Grasp& grasp) {
+  const Pose to_gripper = grasp.gripper.inverse();
+  std::vector<Eigen::Vector3d> v(part.vertices.size());
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = to_gripper * part.vertices[i];
+  return v;
+}
 
-bool apart(const CGAL::Bbox_3& a, const CGAL::Bbox_3& b) {
-  for (int i = 0; i < 3; ++i) {
-    if (a.max(i) < b.min(i) || b.max(i) < a.min(i)) return true;
-  }
-  return false;
+// Whether a triangle of `part` from `first` on meets `box` (`v`: its vertices in the box's frame).
+bool meets(const sim::TriangleMesh& part, const std::vector<Eigen::Vector3d>& v, std::size_t first, const CGAL::Bbox_3& box) {
+  return std::any_of(part.triangles.begin() + static_cast<std::ptrdiff_t>(first), part.triangles.end(), [&](const auto& t) {
+    const auto point = [&](std::uint32_t i) { return Kernel::Point_3(v[i].x(), v[i].y(), v[i].z()); };
+    const Kernel::Triangle_3 triangle(point(t[0]), point(t[1]), point(t[2]));
+    return CGAL::do_overlap(box, triangle.bbox()) && !triangle.is_degenerate() && CGAL::do_intersect(box, triangle);
+  });
 }
 
 }  // namespace
 
 bool fingers_touch(const sim::TriangleMesh& part, const Grasp& grasp, const fb::GripperGeometry& gripper, double within) {
-  // The part in the gripper's frame: the fingers close along x, their inner faces at
-  // +-opening/2, and reach down along -y from the palm (services/node/gripper.hpp).
-  const Pose to_gripper = grasp.gripper.inverse();
-  std::vector<Eigen::Vector3d> v(part.vertices.size());
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = to_gripper * part.vertices[i];
+  const auto v = in_gripper_frame(part, grasp);
   const double half = grasp.opening / 2, top = -gripper.palm_thickness / 2, bottom = top - gripper.finger_length;
   const double width = gripper.finger_width / 2;
   constexpr double kOnTheFace = 1e-6;  // a surface in the box's face plane, rounded
   for (const double side : {-1.0, 1.0}) {
     const double outer = side * (half + kOnTheFace), inner = side * (half - within);
-    const CGAL::Bbox_3 pad(std::min(outer, inner), bottom, -width, std::max(outer, inner), top, width);
-    const bool touched = std::any_of(part.triangles.begin(), part.triangles.end(), [&](const auto& t) {
-      const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
-      const Kernel::Triangle_3 triangle(point(a), point(b), point(c));
-      if (apart(pad, triangle.bbox())) return false;
-      return !triangle.is_degenerate() && CGAL::do_intersect(pad, triangle);
-    });
-    if (!touched) return false;
+    if (!meets(part, v, 0, CGAL::Bbox_3(std::min(outer, inner), bottom, -width, std::max(outer, inner), top, width))) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool gripper_clear_of(const sim::TriangleMesh& part, std::size_t first_triangle, const Grasp& grasp,
+                      const fb::GripperGeometry& gripper, double tolerance) {
+  const auto v = in_gripper_frame(part, grasp);
+  for (const auto& box : fb::gripper_boxes(gripper, grasp.opening)) {
+    const Eigen::Vector3d c = box.pose.translation(), h = (box.half_extents.array() - tolerance).max(0).matrix();
+    if (meets(part, v, first_triangle, CGAL::Bbox_3(c.x() - h.x(), c.y() - h.y(), c.z() - h.z(), c.x() + h.x(), c.y() + h.y(),
+                                                    c.z() + h.z()))) {
+      return false;
+    }
   }
   return true;
 }

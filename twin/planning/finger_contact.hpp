@@ -14,4 +14,10 @@ namespace twin {
 // `within` (m) of their pads.
 bool fingers_touch(const sim::TriangleMesh& part, const Grasp& grasp, const fb::GripperGeometry& gripper, double within);
 
+// True when no box of the gripper at `grasp` (each shrunk by `tolerance`) meets a triangle of
+// `part` from `first_triangle` on: a subassembly gripped by its base (its first triangles)
+// carries its other members, which the gripper must not stand in.
+bool gripper_clear_of(const sim::TriangleMesh& part, std::size_t first_triangle, const Grasp& grasp,
+                      const fb::GripperGeometry& gripper, double tolerance);
+
 }  // namespace twin

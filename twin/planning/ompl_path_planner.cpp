@@ -6,6 +6,7 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include <algorithm>
 #include <mutex>
 
 namespace twin {
@@ -86,8 +87,9 @@ std::optional<Trajectory> OmplPathPlanner::next(const AssemblyScene& scene, Part
   // Then one sampling run for each face the gripper can hold the part by.
   for (std::size_t k = tried.size() - directions.size(); k < directions.size(); ++k) {
     const auto grasps = scene.grasps(part, directions[k].second);
-    if (grasps.empty()) continue;
-    if (auto t = sample_path(scene, part, grasps.front())) return t;
+    const auto holding = std::find_if(grasps.begin(), grasps.end(), [&](const Grasp& g) { return scene.holds(part, g); });
+    if (holding == grasps.end()) continue;
+    if (auto t = sample_path(scene, part, *holding)) return t;
   }
   return std::nullopt;
 }
