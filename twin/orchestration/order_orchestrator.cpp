@@ -469,6 +469,17 @@ Pose OrderOrchestrator::at_dock(const std::string& station, PartIndex part, cons
   return with_translation(start, dock[0], height, dock[2]);
 }
 
+OrderOrchestrator::Carry OrderOrchestrator::carry(const std::string& station, std::size_t index, const Trajectory& t,
+                                                  const Pose& standing) const {
+  const auto& w = t.waypoints;
+  const Pose grip = w.front().part.inverse() * w.front().gripper;
+  const double least = carry_height(index, w.front().part) + places_.at(station).position[1];
+  Carry c;
+  for (const Pose& p : lift_over(standing, at(station, w.front().part), least)) c.holding.push_back(p * grip);
+  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? c.holding : c.retreat).push_back(at(station, w[i].gripper));
+  return c;
+}
+
 Pose OrderOrchestrator::at(const std::string& station, const Pose& pose) const {
   const Numbers& p = places_.at(station).position;
   Pose offset = Pose::Identity();
@@ -566,10 +577,7 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   }
   spawned_.insert(body);
   spawned_.insert(gripper.begin(), gripper.end());
-  std::vector<Pose> holding, retreat;
-  const double least = carry_height(step, w.front().part) + places_.at(virtual_station_).position[1];
-  for (const Pose& p : lift_over(standing, start, least)) holding.push_back(p * grip);
-  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
+  const auto [holding, retreat] = carry(virtual_station_, step, t, standing);
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
   // The palm leads; the fingers, the carriage and (while held) the part go with it.
   std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
@@ -614,10 +622,7 @@ void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t
                                                 {h.x(), h.y(), h.z()}, false, "", scene)});
   }
   spawned_.insert(gripper.begin(), gripper.end());
-  std::vector<Pose> holding, retreat;
-  const double least = carry_height(step, w.front().part) + places_.at(virtual_station_).position[1];
-  for (const Pose& p : lift_over(standing, at(virtual_station_, w.front().part), least)) holding.push_back(p * grip);
-  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(virtual_station_, w[i].gripper));
+  const auto [holding, retreat] = carry(virtual_station_, step, t, standing);
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
   std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
   for (PartIndex member : members) carried.push_back(virtual_body(member));
@@ -840,10 +845,7 @@ void OrderOrchestrator::plan_physical() {
     take["opening"] = t.grasp.opening;
     take["carried"] = fb::join_names({moved.begin() + 1, moved.end()});
     actions_.push_back({Action::command, take});
-    std::vector<Pose> holding, retreat;
-    const double least = carry_height(steps[k], w.front().part) + places_.at(station_).position[1];
-    for (const Pose& p : lift_over(standing, start, least)) holding.push_back(p * grip);
-    for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? holding : retreat).push_back(at(station_, w[i].gripper));
+    const auto [holding, retreat] = carry(station_, steps[k], t, standing);
     add_arm_moves(moved, holding, retreat, unit && !inserts_unit(step) ? unit->name : "");
   }
   next_action();

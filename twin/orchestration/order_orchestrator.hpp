@@ -184,6 +184,13 @@ class OrderOrchestrator : public fb::BasicBlock {
   // Where the robot puts `part` down at the station's dock (in the cell; `start`: where its
   // trajectory starts there).
   Pose at_dock(const std::string& station, PartIndex part, const Pose& start) const;
+  // The gripper's poses at `station` for step `index`'s part gripped where it stands
+  // (`standing`) and carried along `t`: held (up, over what stands, down to the start, along
+  // it), then after the release (backing out). Virtual and physical assembly carry alike.
+  struct Carry {
+    std::vector<Pose> holding, retreat;
+  };
+  Carry carry(const std::string& station, std::size_t index, const Trajectory& t, const Pose& standing) const;
   // The least height (product frame) at which the part of step `index`, at `pose` turned, and
   // what it carries are carried over what stands: the parts its steps before put in the
   // product, and every subassembly built aside; -inf when nothing stands.
