@@ -23,6 +23,7 @@
 #include "deploy/cellctl/supervisor.hpp"
 #include "deploy/cellctl/text_table.hpp"
 #include "deploy/cellctl/twin_identities.hpp"
+#include "deploy/cellctl/twin_pool.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -228,22 +229,29 @@ void check_identities_for(const CellConfig& cell, std::size_t orders) {
   }
 }
 
-// Spawns a twin per order at once and follows them to their ends, printing their progress.
+// Starts a twin per order at once, or hands each order to a twin of `standby` where one
+// stands by, and follows them to their ends, printing their progress.
 void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Order>& orders, CellObserver& observer,
-                double wait_s) {
+                double wait_s, TwinIdentities& identities, TwinPool* standby = nullptr) {
   std::set<std::string> ids;
   for (const auto& order : orders) ids.insert(order.id);
   observer.on_status([ids](const cell::OrderStatus& s) {
     if (ids.count(s.order_id().to_string())) print_progress(s);
   });
-  check_identities_for(cell, orders.size());
-  TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
   for (auto& order : orders) {
     order.sim_start = observer.sim_now();
     // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
-    order.twin = identities.start(order.id, twin_argv(cell, executable_dir(), order.id, order.product, order.out, o.sequence,
-                                                      o.path, cell.state_dir, wait_s))
-                     .process;  // check_identities_for: there is an identity for each
+    if (standby) {
+      order.twin = standby->take("twin-" + order.id, order.id,
+                                 twin_order_args(cell, order.id, order.product, order.out, o.sequence, o.path,
+                                                 cell.state_dir, wait_s, false))
+                       .process;
+    }
+    if (!order.twin) {
+      order.twin = identities.start(order.id, twin_argv(cell, executable_dir(), order.id, order.product, order.out,
+                                                        o.sequence, o.path, cell.state_dir, wait_s))
+                       .process;  // check_identities_for: there is an identity for each
+    }
   }
   for (std::size_t running = orders.size(); running > 0;) {
     running = 0;
@@ -445,7 +453,9 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       return;
     }
     // No cellctl up on the domain (a cell of processes started by hand): the twin runs here.
-    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
+    check_identities_for(cell, orders.size());
+    TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
+    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities);
     const Order& order = orders.front();
     std::cout << "twin peak RSS " << order.peak_rss_kb / 1024 << " MB\n";
     if (order.exit_code == 0) std::cout << "order " << order.id << " done: " << order.out << "/report.html, " << order.out << "/plan.json, " << order.out << "/animation.gltf\n";
@@ -542,9 +552,13 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     CellObserver observer(cell.participant_settings("cellctl"));
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();
+    // A twin per order stands by while the cell comes up, as `up`'s desk keeps them: an order
+    // starts in a twin that has joined the cell (docs/performance.md "Twin start-up").
+    TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
+    TwinPool standby(twin_standby_argv(cell, executable_dir()), static_cast<int>(orders.size()), identities);
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
     std::cout << "cell up on domain " << cell.domain << ", real-time factor " << cell.real_time_factor << std::endl;
-    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s);
+    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities, &standby);
     const bool all = report_orders(orders, observer);
     exit_code = all ? 0 : 1;
     while (Process* p = running.ended()) {  // a cell process that did not last the run is a fault

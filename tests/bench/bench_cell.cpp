@@ -54,22 +54,26 @@ int echo(int domain) {
   return 0;
 }
 
+// The i-th command to `resource`; `award`: what the command names (a resource obeys only the
+// order that hired it).
+cell::Command command(const std::string& resource, const std::string& award, int i) {
+  cell::Command c;
+  c.command_id(resource + "-" + std::to_string(i));
+  c.resource_id(resource);
+  c.order_id("bench");
+  c.award(award);
+  c.operation("give");
+  c.part_type("Part");
+  c.destination("bench");  // a give names who takes the part
+  return c;
+}
+
 // Sends `rounds` commands on `topic`, each after the answer to the one before.
-// `award`: what the commands name (a resource obeys only the order that hired it).
 std::vector<double> round_trips(const dds::ParticipantPtr& participant, const std::string& topic,
                                 const std::string& answers_topic, const std::string& resource, int rounds,
                                 const std::string& award = "") {
-  return bench::round_trips(participant, participant, topic, answers_topic, rounds, [&](int i) {
-    cell::Command c;
-    c.command_id(resource + "-" + std::to_string(i));
-    c.resource_id(resource);
-    c.order_id("bench");
-    c.award(award);
-    c.operation("give");
-    c.part_type("Part");
-    c.destination("bench");  // a give names who takes the part
-    return c;
-  });
+  return bench::round_trips(participant, participant, topic, answers_topic, rounds,
+                            [&](int i) { return command(resource, award, i); });
 }
 
 // With cell-sim and a station running (the twin needs both before virtual assembly): twins
@@ -85,39 +89,48 @@ void twin_start(int domain, int rounds) {
   sim.stop();
 }
 
-// Gives from the buffer "bench-buffer", hired first as a twin hires it.
-std::vector<double> buffer_round_trips(const dds::ParticipantPtr& participant, int rounds) {
+// Hires the buffer "bench-buffer" as a twin hires it, for `rounds` gives and some to spare.
+std::string hire_buffer(const dds::ParticipantPtr& participant, int rounds) {
   std::string why;
-  const std::string award = test::hire(participant, "bench-buffer", "bench", "give", {"", "Part", rounds + 20}, &why);
+  const std::string award = test::hire(participant, "bench-buffer", "bench", "give", {"", "Part", rounds + 40}, &why);
   if (award.empty()) throw std::runtime_error("cannot hire bench-buffer: " + why);
+  return award;
+}
+
+std::vector<double> buffer_round_trips(const dds::ParticipantPtr& participant, int rounds) {
   return round_trips(participant, dds::command_topic("bench-buffer"), "cell/command_events", "bench-buffer", rounds,
-                     award);
+                     hire_buffer(participant, rounds));
 }
 
 // The round trips while a cell assembles 10 orders on the same host (the bench's echo and
-// buffer on a domain of their own, the cell on another).
+// buffer on a domain of their own, the cell on another). A bare round and a command's round
+// take turns, so that both meet the same load: the orders' work changes as they go on.
 void under_load(const char* self, int domain, int rounds) {
   std::vector<std::string> args{CELLCTL_EXE, "run", "--domain", std::to_string(domain + 2)};
   for (int i = 0; i < 10; ++i) {
     args.push_back(std::string(PRODUCTS_DIR) + (i % 2 == 0 ? "/lego-tower/lego-tower.aml" : "/cranfield/cranfield.aml"));
   }
   args.insert(args.end(), {"--out", "/tmp/bench-cell-load"});
+  auto participant = dds::make_participant("bench", {domain, true, {}});
+  test::ChildProcess echo_side({self, "--echo", std::to_string(domain)});
+  test::ChildProcess buffer({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(domain), "--stock",
+                             "Part=1000000"});
+  const std::string award = hire_buffer(participant, rounds);
+  bench::RoundTrips bare(participant, participant, "bench/ping", "bench/pong");
+  bench::RoundTrips to_buffer(participant, participant, dds::command_topic("bench-buffer"), "cell/command_events");
   test::ChildProcess cell(args, "/tmp/bench-cell-load.log");
   std::this_thread::sleep_for(3s);  // the cell is up and the twins plan and assemble virtually
-  auto participant = dds::make_participant("bench", {domain, true, {}});
-  {
-    test::ChildProcess echo_side({self, "--echo", std::to_string(domain)});
-    report("while 10 orders run: bare Fast DDS ping-pong", round_trips(participant, "bench/ping", "bench/pong", "echo", rounds));
-    echo_side.stop();
+  std::vector<double> bare_us, command_us;
+  for (int i = 0; i < rounds; ++i) {
+    bare_us.push_back(bare.once(command("echo", "", i)));
+    command_us.push_back(to_buffer.once(command("bench-buffer", award, i)));
   }
-  {
-    test::ChildProcess buffer({BUFFER_EXE, "--id", "bench-buffer", "--domain", std::to_string(domain), "--stock",
-                               "Part=1000000"});
-    report("while 10 orders run: command to SUCCEEDED, buffer process", buffer_round_trips(participant, rounds));
-    buffer.stop();
-  }
+  report("while 10 orders run: bare Fast DDS ping-pong", bare_us);
+  report("while 10 orders run: command to SUCCEEDED, buffer process", command_us);
   const int code = cell.wait_for_exit(std::chrono::minutes(5));
   std::cout << "  (the 10 orders' cellctl run ended with exit " << code << ")" << std::endl;
+  buffer.stop();
+  echo_side.stop();
 }
 
 }  // namespace

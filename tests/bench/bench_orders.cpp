@@ -6,10 +6,12 @@
 //    its own work: from its first command to its last, plus the time before any order could
 //    start physical work (planning and virtual assembly);
 //  - the peak RSS of every process (cellctl's table: cell processes, and each twin).
+// BENCH_KEEP=1 keeps the event log and the twins' output in the temporary directory.
 // Run: build/release/bin/bench_orders [--orders 10] [--cell deploy/cells/two-stations.yaml]
 //      [--domain 201] [--real-time-factor 20]
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -78,15 +80,39 @@ int main(int argc, char** argv) {
 
   // The arms' busy time: every arm command from accepted to its end, physical parts only.
   std::map<std::string, Span> commands, of_order;
+  std::map<std::string, std::string> arm_of;
   std::ifstream events(dir / "events.jsonl");
   for (std::string line; std::getline(events, line);) {
     const json e = json::parse(line);
     const double t = e["t"];
     of_order[e["order"]].add(t);
-    if (std::string(e["resource"]).rfind("arm-", 0) == 0) commands[e["command"]].add(t);
+    const std::string resource = e["resource"];
+    if (resource.rfind("arm-", 0) == 0) {
+      commands[e["command"]].add(t);
+      arm_of[e["command"]] = resource;
+    }
   }
   double arm_busy = 0;
   for (const auto& [id, span] : commands) arm_busy += span.end - span.start;
+
+  // Where each arm's time went: its first command, its last, and the gaps between commands.
+  std::map<std::string, std::vector<Span>> spans_of_arm;
+  for (const auto& [id, span] : commands) spans_of_arm[arm_of[id]].push_back(span);
+  std::ostringstream arms;
+  for (auto& [arm, spans] : spans_of_arm) {
+    std::sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) { return a.start < b.start; });
+    double busy = 0, idle = 0, long_idle = 0, end = spans.front().start;
+    int long_gaps = 0;
+    for (const Span& s : spans) {
+      busy += s.end - s.start;
+      const double gap = std::max(0.0, s.start - end);
+      idle += gap;
+      if (gap > 1.0) ++long_gaps, long_idle += gap;
+      end = std::max(end, s.end);
+    }
+    arms << "  " << arm << ": first command " << spans.front().start << ", last end " << end << ", busy " << busy
+         << ", idle between " << idle << " (" << long_gaps << " gaps over 1 s: " << long_idle << ")\n";
+  }
 
   // Sim start and end per order, and the makespan, from cellctl's table.
   const std::regex row(R"(^(\S+)\s+\S+\.aml\s+assembled\s+([0-9.]+)\s+([0-9.]+)\s+([0-9]+))");
@@ -116,10 +142,11 @@ int main(int argc, char** argv) {
             << "  makespan " << makespan << " sim s\n"
             << "  arm busy " << arm_busy << " sim s over " << stations << " stations: " << arm_busy / stations << "\n"
             << "  longest single order " << longest << " sim s (of it " << before_work << " before any physical work)\n"
-            << "  lower bound " << bound << " sim s; makespan / bound " << makespan / bound << "\n"
+            << arms.str() << "  lower bound " << bound << " sim s; makespan / bound " << makespan / bound << "\n"
             << "  peak RSS MB: twin (largest) " << twin_rss;
   for (const auto& [name, mb] : rss) std::cout << ", " << name << " " << mb;
   std::cout << std::endl;
-  fs::remove_all(dir);
+  if (std::getenv("BENCH_KEEP") == nullptr) fs::remove_all(dir);
+  else std::cout << "  kept " << dir.string() << std::endl;
   return 0;
 }

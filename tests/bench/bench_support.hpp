@@ -51,28 +51,46 @@ struct Answers {
   }
 };
 
-// Writes `rounds` commands (after 20 warm-up rounds) on `topic` from `sender`, each after the
-// SUCCEEDED of the one before, heard on `answers_topic` by `listener`; the round trips, us.
-// `make(i)` makes the i-th command; `settings`: the writer's (a robot's gives go in its own
+// Commands written on `topic` from `sender`, each timed until its SUCCEEDED event is heard
+// on `answers_topic` by `listener`. `settings`: the writer's (a robot's gives go in its own
 // partition, where a buffer under DDS-Security takes them).
+class RoundTrips {
+ public:
+  RoundTrips(const dds::ParticipantPtr& sender, const dds::ParticipantPtr& listener, const std::string& topic,
+             const std::string& answers_topic, const dds::QosSettings& settings = {})
+      : reader_(listener, answers_topic, dds::TopicKind::events,
+                [this](const cell::CommandEvent& e) {
+                  if (e.state() == cell::SUCCEEDED) answers_.answer(e.command_id().to_string());
+                }),
+        writer_(sender, topic, dds::TopicKind::events, settings) {
+    if (!writer_.wait_for_readers(1, std::chrono::seconds(20))) throw std::runtime_error("nobody reads " + topic);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the reader's side of the match, too
+  }
+
+  // One command's round trip, us.
+  double once(const cell::Command& c) {
+    const auto start = Clock::now();
+    writer_.write(c);
+    if (!answers_.wait(c.command_id().to_string())) throw std::runtime_error("no answer to " + c.command_id().to_string());
+    return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  }
+
+ private:
+  Answers answers_;
+  EventReader reader_;
+  CommandWriter writer_;
+};
+
+// `rounds` round trips after 20 warm-up rounds, one after another; `make(i)` makes the i-th.
 inline std::vector<double> round_trips(const dds::ParticipantPtr& sender, const dds::ParticipantPtr& listener,
                                        const std::string& topic, const std::string& answers_topic, int rounds,
                                        const std::function<cell::Command(int)>& make,
                                        const dds::QosSettings& settings = {}) {
-  Answers answers;
-  EventReader reader(listener, answers_topic, dds::TopicKind::events, [&](const cell::CommandEvent& e) {
-    if (e.state() == cell::SUCCEEDED) answers.answer(e.command_id().to_string());
-  });
-  CommandWriter writer(sender, topic, dds::TopicKind::events, settings);
-  if (!writer.wait_for_readers(1, std::chrono::seconds(20))) throw std::runtime_error("nobody reads " + topic);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the reader's side of the match, too
+  RoundTrips trips(sender, listener, topic, answers_topic, settings);
   std::vector<double> us;
   for (int i = -20; i < rounds; ++i) {
-    const cell::Command c = make(i + 100);
-    const auto start = Clock::now();
-    writer.write(c);
-    if (!answers.wait(c.command_id().to_string())) throw std::runtime_error("no answer to " + c.command_id().to_string());
-    if (i >= 0) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+    const double t = trips.once(make(i + 100));
+    if (i >= 0) us.push_back(t);
   }
   return us;
 }
