@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include "tests/twin/test_support.hpp"
+#include "twin/description/automationml/precedence_writer.hpp"
+#include "twin/planning/precedence_suggestions.hpp"
 #include "twin/planning/subassembly_planner.hpp"
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/plan_json.hpp"
@@ -261,4 +263,50 @@ TEST_CASE("subassemblies: an order element holding the product's element is not 
   REQUIRE(groups.size() == 1);
   CHECK(groups[0].name == "ShaftPendulum");
   CHECK(test::part(loaded.product, "back").subassembly.empty());
+}
+
+TEST_CASE("subassemblies: precedences are suggested level by level, and written into the product they settle its order",
+          "[planning][subassembly][suggest]") {
+  // The nested Cranfield's subassembly leaves no choice among its two parts; the product's
+  // level leaves several, among its parts and the subassembly.
+  const auto dir = std::filesystem::temp_directory_path() / ("subassembly-suggest-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto loaded = test::load(test::data(kNested));
+  twin::PlannerOptions options;
+  options.max_backtracks = 20;  // an alternative that cannot go together is shown so soon enough
+  twin::Plan plan = plan_of(loaded, options);
+  REQUIRE(plan.complete);
+  twin::SearchSequencePlanner sequence;
+  const auto suggestions = twin::suggest_precedences(loaded, plan, sequence, *twin::make_path_planner("linear"), options);
+  const auto& parts = loaded.product.parts();
+  CHECK(std::any_of(suggestions.begin(), suggestions.end(), [&](const twin::PrecedenceSuggestion& s) {
+    return parts[s.before].name == "back" && parts[s.after].name == "shaft";  // the subassembly's base stands for it
+  }));
+  CHECK(std::any_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) {
+    return f.kind == "suggestion" && f.message.find("put back before ShaftPendulum") != std::string::npos;
+  }));
+  for (const auto& s : suggestions) {  // the step a suggestion names is its part's, in the whole plan
+    INFO(s.why);
+    REQUIRE(s.step < plan.steps.size());
+    CHECK(plan.steps[s.step].part == s.before);
+  }
+
+  std::vector<std::pair<twin::PartIndex, twin::PartIndex>> rules;
+  for (const auto& s : suggestions) rules.emplace_back(s.before, s.after);
+  twin::write_with_precedences(loaded.product, rules, dir / "settled.aml");
+  const auto settled = test::load(dir / "settled.aml");
+  CHECK(settled.product.precedences().size() == suggestions.size());
+  const twin::Plan again = plan_of(settled, options);
+  REQUIRE(again.complete);
+  const auto order = [](const twin::LoadedProduct& product, const twin::Plan& p) {
+    std::vector<std::string> names;
+    for (const auto& step : p.steps) names.push_back(step.subassembly + "/" + product.product.parts()[step.part].name);
+    return names;
+  };
+  CHECK(order(settled, again) == order(loaded, plan));
+  const auto open_choices = [](const twin::Plan& p) {
+    return std::count_if(p.findings.begin(), p.findings.end(), [](const twin::Finding& f) { return f.kind == "open-order"; });
+  };
+  CHECK(open_choices(again) < open_choices(plan));
+  std::filesystem::remove_all(dir);
 }

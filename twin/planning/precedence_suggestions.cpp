@@ -18,12 +18,12 @@ std::string mm(double metres) {
   return buffer;
 }
 
-}  // namespace
-
-std::vector<PrecedenceSuggestion> suggest_precedences(const LoadedProduct& product, Plan& plan, SequencePlanner& sequence,
-                                                      PathPlanner& path, const PlannerOptions& options) {
-  std::vector<PrecedenceSuggestion> out;
-  if (!plan.complete || !subassemblies_of(product.product).empty()) return out;
+// The suggestions of one product without subassemblies and its plan. `origin`: each of its
+// parts in the whole product; `offset`: the plan's first step in the whole plan; the
+// findings go to `whole`.
+void suggest_at(const LoadedProduct& product, const Plan& plan, const std::vector<PartIndex>& origin, std::size_t offset,
+                SequencePlanner& sequence, PathPlanner& path, const PlannerOptions& options,
+                std::vector<PrecedenceSuggestion>& out, Plan& whole) {
   const auto& parts = product.product.parts();
   const double least = least_margin(plan.steps, options.margin_reach);
   AssemblyScene scene(product, options.collision, options.gripper);
@@ -58,14 +58,38 @@ std::vector<PrecedenceSuggestion> suggest_precedences(const LoadedProduct& produ
                 "), and the planner would take it first";
         }
         if (why.empty()) continue;
-        out.push_back({step.part, other, i, why});
-        plan.findings.push_back({"suggestion",
-                                 "step " + std::to_string(i + 1) + ": put " + parts[step.part].name + " before " +
-                                     parts[other].name + ": " + why,
-                                 {parts[step.part].name, parts[other].name}});
+        out.push_back({origin[step.part], origin[other], offset + i, why});
+        whole.findings.push_back({"suggestion",
+                                  "step " + std::to_string(offset + i + 1) + ": put " + parts[step.part].name + " before " +
+                                      parts[other].name + ": " + why,
+                                  {parts[step.part].name, parts[other].name}});
       }
     }
     scene.assemble(step.part);
+  }
+}
+
+}  // namespace
+
+std::vector<PrecedenceSuggestion> suggest_precedences(const LoadedProduct& product, Plan& plan, SequencePlanner& sequence,
+                                                      PathPlanner& path, const PlannerOptions& options) {
+  std::vector<PrecedenceSuggestion> out;
+  if (!plan.complete) return out;
+  if (subassemblies_of(product.product).empty()) {
+    std::vector<PartIndex> same(product.product.parts().size());
+    for (PartIndex p = 0; p < same.size(); ++p) same[p] = p;
+    suggest_at(product, plan, same, 0, sequence, path, options, out, plan);
+    return out;
+  }
+  // Level by level, each planned as the whole plan planned it: a subassembly's open choices
+  // among its own parts, the product's among its parts and subassemblies (a rule that names
+  // a subassembly's base holds for the whole subassembly).
+  std::size_t offset = 0;
+  for (const PlanLevel& level : plan_levels(product).levels) {
+    const Plan own = plan_assembly(level.product, sequence, path, options);
+    if (!own.complete) return out;
+    suggest_at(level.product, own, level.origin, offset, sequence, path, options, out, plan);
+    offset += own.steps.size();
   }
   return out;
 }

@@ -20,8 +20,9 @@ struct PrecedenceSuggestion {
   std::string why;
 };
 
-// For a product without subassemblies (none are suggested for one with). Adds a "suggestion"
-// finding to the plan for each.
+// Adds a "suggestion" finding to the plan for each. A product with subassemblies gets them
+// level by level (plan_levels): within each subassembly among its parts, and in the product
+// among its parts and subassemblies, where a rule names the subassembly by its base part.
 std::vector<PrecedenceSuggestion> suggest_precedences(const LoadedProduct& product, Plan& plan, SequencePlanner& sequence,
                                                       PathPlanner& path, const PlannerOptions& options);
 

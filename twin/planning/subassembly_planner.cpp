@@ -200,58 +200,63 @@ std::shared_ptr<const sim::TriangleMesh> merged_mesh(const LoadedProduct& produc
   return out;
 }
 
+PlanLevels plan_levels(const LoadedProduct& product) {
+  PlanLevels out;
+  out.subassemblies = subassemblies_of(product.product);
+  // Each subassembly built beside what stands left of it, its lowest point on the station.
+  std::vector<PartIndex> all(product.product.parts().size());
+  for (PartIndex p = 0; p < all.size(); ++p) all[p] = p;
+  double beside = final_bounds(product, all).max().x() + kAsideGap;
+  for (const Subassembly& s : out.subassemblies) {
+    const Eigen::AlignedBox3d box = final_bounds(product, s.members);
+    const Vec3 aside(beside - box.min().x(), -box.min().y(), 0);
+    beside += box.sizes().x() + kAsideGap;
+    out.levels.push_back({s.name, subassembly_product(product, s, aside), s.members, {}, aside});
+  }
+  std::vector<const Subassembly*> unit_of;
+  std::vector<PartIndex> origin;
+  LoadedProduct units = product_of_units(product, out.subassemblies, unit_of, origin, out.conflicts);
+  if (!out.conflicts.empty()) return out;
+  std::vector<int> unit;
+  for (const Subassembly* u : unit_of) unit.push_back(u ? static_cast<int>(u - out.subassemblies.data()) : -1);
+  out.levels.push_back({"", std::move(units), std::move(origin), std::move(unit), Vec3::Zero()});
+  return out;
+}
+
 Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
                              const PlannerOptions& options) {
-  const std::vector<Subassembly> subassemblies = subassemblies_of(product.product);
+  const PlanLevels levels = plan_levels(product);
   Plan plan;
   plan.complete = true;
   plan.sequence_planner = sequence.name();
   plan.path_planner = path.name();
   plan.margin_threshold = options.margin_threshold;
   plan.margin_reach = options.margin_reach;
-
-  // Each subassembly built beside what stands left of it, its lowest point on the station.
-  std::vector<PartIndex> all(product.product.parts().size());
-  for (PartIndex p = 0; p < all.size(); ++p) all[p] = p;
-  double beside = final_bounds(product, all).max().x() + kAsideGap;
-  for (const Subassembly& s : subassemblies) {
-    const Eigen::AlignedBox3d box = final_bounds(product, s.members);
-    const Vec3 aside(beside - box.min().x(), -box.min().y(), 0);
-    beside += box.sizes().x() + kAsideGap;
-    Plan own = plan_assembly(subassembly_product(product, s, aside), sequence, path, options);
+  for (const PlanLevel& level : levels.levels) {
+    Plan own = plan_assembly(level.product, sequence, path, options);
     for (PlanStep step : own.steps) {
-      step.part = s.members[step.part];
-      step.allowed = mapped(step.allowed, s.members);
-      step.subassembly = s.name;
+      step.allowed = mapped(step.allowed, level.origin);
+      if (!level.subassembly.empty()) {
+        step.subassembly = level.subassembly;
+      } else if (const int u = level.unit[step.part]; u >= 0) {
+        const Subassembly& s = levels.subassemblies[static_cast<std::size_t>(u)];
+        step.subassembly = s.name;
+        step.carried.assign(s.members.begin() + 1, s.members.end());
+      }
+      step.part = level.origin[step.part];
       plan.steps.push_back(std::move(step));
     }
-    add_plan(plan, std::move(own), "subassembly " + s.name + ": ");
-    plan.subassemblies.push_back({s.name, s.members, aside});
+    add_plan(plan, std::move(own), level.subassembly.empty() ? "" : "subassembly " + level.subassembly + ": ");
+    if (!level.subassembly.empty()) {
+      plan.subassemblies.push_back({level.subassembly, level.origin, level.aside});
+    }
   }
-
-  std::vector<const Subassembly*> unit_of;
-  std::vector<PartIndex> origin;
-  std::vector<std::string> conflicts;
-  const LoadedProduct units = product_of_units(product, subassemblies, unit_of, origin, conflicts);
-  if (!conflicts.empty()) {
+  if (!levels.conflicts.empty()) {
     plan.complete = false;
-    for (const auto& why : conflicts) {
+    for (const auto& why : levels.conflicts) {
       plan.findings.push_back({"infeasible", "the precedences cannot hold with each subassembly inserted whole: " + why, {}});
     }
-    return plan;
   }
-  Plan top = plan_assembly(units, sequence, path, options);
-  for (PlanStep step : top.steps) {
-    const Subassembly* unit = unit_of[step.part];
-    step.allowed = mapped(step.allowed, origin);
-    if (unit) {
-      step.subassembly = unit->name;
-      step.carried.assign(unit->members.begin() + 1, unit->members.end());
-    }
-    step.part = origin[step.part];
-    plan.steps.push_back(std::move(step));
-  }
-  add_plan(plan, std::move(top), "");
   return plan;
 }
 

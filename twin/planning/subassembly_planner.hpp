@@ -32,6 +32,26 @@ std::vector<Subassembly> subassemblies_of(const Product& product);
 // its bores stay open.
 std::shared_ptr<const sim::TriangleMesh> merged_mesh(const LoadedProduct& product, const std::vector<PartIndex>& members);
 
+// One level of a hierarchical plan: a subassembly built aside on its own, or the product
+// with each subassembly one part.
+struct PlanLevel {
+  std::string subassembly;  // the one built at this level; empty: the product
+  LoadedProduct product;    // what this level plans, its parts in its own indices
+  std::vector<PartIndex> origin;  // each of its parts in the product (a subassembly's: its base)
+  std::vector<int> unit;    // the product's level: per part, the subassembly it stands for, or -1
+  Vec3 aside;               // a subassembly's level: where it is built, in the product's frame
+};
+
+struct PlanLevels {
+  std::vector<Subassembly> subassemblies;
+  std::vector<PlanLevel> levels;  // in the order the plan builds them: subassemblies, then the product
+  // Precedences that cannot hold with each subassembly inserted whole: then the product's
+  // level is not there.
+  std::vector<std::string> conflicts;
+};
+
+PlanLevels plan_levels(const LoadedProduct& product);
+
 Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
                              const PlannerOptions& options);
 
