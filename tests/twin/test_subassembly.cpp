@@ -310,3 +310,37 @@ TEST_CASE("subassemblies: precedences are suggested level by level, and written 
   CHECK(open_choices(again) < open_choices(plan));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("subassemblies: one whose base cannot be gripped clear of its other members says so", "[planning][subassembly]") {
+  // The backtrack product's plate, block and cap as one subassembly, and a peg beside it on
+  // the plate: the plate is gripped across its 100 mm from above, where the cap stands.
+  const auto dir = std::filesystem::temp_directory_path() / ("subassembly-capped-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto source = test::data("planning/backtrack/backtrack.aml");
+  std::filesystem::copy(source.parent_path() / "meshes", dir / "meshes",
+                        std::filesystem::copy_options::recursive | std::filesystem::copy_options::overwrite_existing);
+  std::string text = text_of(source);
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    text.replace(at, from.size(), to);
+  };
+  replace(R"(<InternalElement Name="base")", R"(<InternalElement Name="Capped" ID="capped"><InternalElement Name="base")");
+  replace(R"(block:bottom" />)", R"(block:bottom" /></InternalElement>
+      <InternalElement Name="peg" ID="peg" RefBaseSystemUnitPath="Parts/Block" />
+      <InternalLink Name="L3" RefPartnerSideA="base:side" RefPartnerSideB="peg:bottom" />)");
+  replace(R"(<ExternalInterface Name="block" ID="Plate-block" />)", R"(<ExternalInterface Name="block" ID="Plate-block" />
+      <Attribute Name="side" Unit="mm"><DefaultValue>35,10,0</DefaultValue></Attribute>
+      <ExternalInterface Name="side" ID="Plate-side" />)");
+  std::ofstream(dir / "capped.aml") << text;
+  const auto loaded = test::load(dir / "capped.aml");
+  REQUIRE(twin::subassemblies_of(loaded.product).size() == 1);
+  const twin::Plan plan = plan_of(loaded);
+  CHECK_FALSE(plan.complete);
+  CHECK(plan.steps.size() == 3);  // the subassembly is built
+  CHECK(std::any_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) {
+    return f.kind == "infeasible" && f.message.rfind("Capped: ", 0) == 0 &&
+           f.message.find("grasps of its base would put the gripper in its other members") != std::string::npos;
+  }));
+  std::filesystem::remove_all(dir);
+}

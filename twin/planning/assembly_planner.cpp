@@ -215,6 +215,10 @@ class Search {
         why.push_back(what + " (deepest: the " + c.member + " hit " + c.with + " " + millimetres(c.depth) +
                       " deep while " + c.phase + ")");
       }
+      if (const std::size_t n = scene_.grasps_in_members(p); n > 0) {
+        why.push_back(std::to_string(n) + (n == 1 ? " grasp" : " grasps") + " of its base would put the gripper in its " +
+                      "other members (a subassembly is gripped by its base)");
+      }
       for (const Interference& i : interferences_) {
         const PartIndex other = i.part1 == p ? i.part2 : i.part2 == p ? i.part1 : p;
         if (other != p && blockers.count(name(other))) why.push_back(describe(product_.product, i));

@@ -133,8 +133,14 @@ bool AssemblyScene::holds(PartIndex part, const Grasp& grasp) const {
   const auto& whole = product_.meshes[part];
   if (ok && whole && whole != mesh) {
     ok = gripper_clear_of(*whole, mesh->triangles.size(), grasp, gripper_, world_.options().contact_tolerance);
+    if (!ok) in_members_[part].insert(grasp.label);
   }
   return holds_[key] = ok;
+}
+
+std::size_t AssemblyScene::grasps_in_members(PartIndex part) const {
+  const auto it = in_members_.find(part);
+  return it == in_members_.end() ? 0 : it->second.size();
 }
 
 std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajectory& trajectory) const {

@@ -71,6 +71,9 @@ class AssemblyScene {
   // Whether the grasp's fingers both have the part's surface at their pads (a finger on a
   // face of a concave part's box may close on air: finger_contact.hpp).
   bool holds(PartIndex part, const Grasp& grasp) const;
+  // How many of a subassembly's grasps (by its base) holds() refused so far because the
+  // gripper would stand in its other members.
+  std::size_t grasps_in_members(PartIndex part) const;
   // Runs the trajectory in the collision world: the held part with the arm, then the arm
   // alone once it has let go. The first collision, or nothing; a grasp that does not hold
   // the part is one of phase "gripping", before any move.
@@ -113,6 +116,7 @@ class AssemblyScene {
   std::map<sim::BodyId, std::string> names_;
   // holds(), by part and grasp label (a label names one grasp of a part's box).
   mutable std::map<std::pair<PartIndex, std::string>, bool> holds_;
+  mutable std::map<PartIndex, std::set<std::string>> in_members_;  // grasps refused: the gripper in other members
 };
 
 }  // namespace twin
