@@ -114,6 +114,12 @@ void Contractor::reply(const std::string& call_id, const std::string& order, boo
 void Contractor::award(const Data& d) {
   const std::string& call = get<std::string>(d, "call_id");
   const std::string& order = get<std::string>(d, "order_id");
+  // A call it took already, awarded again (its confirmation came too late for the order, which
+  // called again): confirmed again, not taken twice (a buffer would keep its parts twice).
+  if (const long place = place_of(order, call); place >= 0) {
+    bids_.erase(call);
+    return reply(call, order, true, "", place);
+  }
   const auto bid = bids_.find(call);
   if (bid == bids_.end()) return reply(call, order, false, resource_id_ + " made no offer for call " + call, 0);
   if (get<std::string>(bid->second, "order_id") != order) {
@@ -146,6 +152,20 @@ void Contractor::award(const Data& d) {
   }
   emit("RESERVED", {{"order_id", holder_.order}});
   emit("AWARDED", std::move(awarded));
+}
+
+// Where the order's award of `call` stands: 0 held (or taken on, shared), n the n-th in the
+// queue; -1 not taken.
+long Contractor::place_of(const std::string& order, const std::string& call) const {
+  if (!exclusive_) {
+    const auto it = work_.find(order);
+    return it != work_.end() && it->second.count(call) ? 0 : -1;
+  }
+  if (holder_.order == order && holder_.calls.count(call)) return 0;
+  for (std::size_t i = 0; i < waiting_.size(); ++i) {
+    if (waiting_[i].order == order && waiting_[i].calls.count(call)) return static_cast<long>(i) + 1;
+  }
+  return -1;
 }
 
 // The order is done with this resource: released, or ended.

@@ -78,6 +78,7 @@ class Contractor : public BasicBlock {
   };
   double earliest_start(const std::string& order, double now) const;
   void award(const Data& award);
+  long place_of(const std::string& order, const std::string& call) const;
   void end(const std::string& order);
   void propose(const Data& call);
   void reply(const std::string& call_id, const std::string& order, bool confirmed, const std::string& reason, long ahead);

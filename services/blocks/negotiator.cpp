@@ -36,13 +36,14 @@ void Negotiator::receive(const Event& e) {
     operations_.erase(resource);
     for (auto& [id, c] : calls_) {
       c.bids.erase(resource);
+      c.late.erase(resource);
       if (c.awarded == resource) refused(id, resource, resource + " disappeared");
     }
     return;
   }
   if (e.name == "CALL" || e.name == "ASK") {
     Call& c = calls_[get<std::string>(e.data, "call_id")];
-    c = Call{e.data, Clock::now(), {}, {}, {}, {}, {}, e.name == "ASK"};
+    c = Call{e.data, Clock::now(), {}, {}, {}, {}, {}, e.name == "ASK", {}};
     c.data["order_id"] = order_id_;
     return call(c);
   }
@@ -65,9 +66,13 @@ void Negotiator::receive(const Event& e) {
     if (!c.awarded.empty() || !all_answered(c)) return;
     const std::string id = it->first;
     if (decide(id)) calls_.erase(id);
-  } else if (e.name == "AWARD_REPLY" && resource == c.awarded) {
-    if (!get<bool>(e.data, "confirmed")) return refused(it->first, resource, get<std::string>(e.data, "reason"));
-    const Bid bid = c.bids[resource];
+  } else if (e.name == "AWARD_REPLY" && (resource == c.awarded || (c.awarded.empty() && c.late.count(resource)))) {
+    const bool late = resource != c.awarded;
+    if (!get<bool>(e.data, "confirmed")) {
+      if (late) return;  // refused what was given up on already
+      return refused(it->first, resource, get<std::string>(e.data, "reason"));
+    }
+    const Bid bid = late ? c.late.at(resource) : c.bids[resource];
     const std::string id = it->first;
     calls_.erase(it);
     emit("AWARDED", {{"call_id", id}, {"resource_id", resource}, {"ahead", get<std::int64_t>(e.data, "ahead")},
@@ -126,6 +131,7 @@ void Negotiator::tick() {
   for (auto& [id, c] : calls_) {
     if (!c.awarded.empty()) {
       if (now - c.awarded_at > settings_.reply_timeout) {
+        if (c.bids.count(c.awarded)) c.late[c.awarded] = c.bids.at(c.awarded);
         refused(id, c.awarded, c.awarded + " did not confirm within " +
                                    std::to_string(settings_.reply_timeout.count()) + " ms");
       }

@@ -81,6 +81,9 @@ class Negotiator : public FunctionBlock {
     std::map<std::string, std::string> refusals;  // resource -> why
     std::string awarded;                          // waiting for its reply
     bool quote = false;                           // ASK: the best bid is reported, not awarded
+    // Awarded before, and its reply did not come in time: a confirmation that still comes
+    // is taken (the resource holds what it confirmed), while no other award is out.
+    std::map<std::string, Bid> late;
   };
   void call(Call& c);
   // Awards the best bid, or reports it for a call for quotes (which ends the call: true).

@@ -239,6 +239,44 @@ TEST_CASE("negotiator: a call nobody bids on is called again, then unavailable w
   CHECK(reason.find("robot-1") == std::string::npos);
 }
 
+TEST_CASE("negotiator: a confirmation that comes after the reply timeout is taken, and the resource takes the call once",
+          "[fb][negotiation]") {
+  // A buffer slowed down (a loaded machine) confirms later than the twin waits: the twin
+  // called again, and the buffer, awarded again, kept its parts a second time until it had
+  // none free ("nobody offered give RoundPeg", a TSan run in CI).
+  fb::NegotiationSettings settings = quick();
+  settings.reply_timeout = std::chrono::milliseconds(0);
+  settings.wait = std::chrono::milliseconds(10000);
+  fb::BlockTestFixture<fb::Negotiator> twin("negotiator", "o1", settings);
+  fb::BlockTestFixture<fb::Contractor> buffer("contractor", "buffer-2", std::set<std::string>{"give"}, false, holds(),
+                                              [] { return now; });
+  twin.send("CAPABILITY", capability("buffer-2", "give"));
+  const auto first = twin.send("CALL", cfp("o1", "give", 0));
+  REQUIRE(names<fb::Negotiator>(first) == Names{"CFP"});
+  buffer.send("CFP", first[0].data);
+  REQUIRE(names<fb::Negotiator>(twin.send("PROPOSAL", proposal("o1/give", "buffer-2", 0, 1))) == Names{"AWARD"});
+  const auto taken = buffer.send("AWARD", award("o1", "give", "buffer-2"));
+  REQUIRE(names<fb::Contractor>(taken) == Names{"REPLY", "AWARDED"});
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  CHECK(twin.send("TICK").empty());                                  // given up on
+  CHECK(names<fb::Negotiator>(twin.send("TICK")) == Names{"CFP"});  // and called again
+  const auto again = buffer.send("CFP", cfp("o1", "give", 0));
+  REQUIRE(names<fb::Contractor>(again) == Names{"PROPOSE"});
+  // Awarded a second time for the same call: confirmed, nothing taken twice.
+  const auto twice = buffer.send("AWARD", award("o1", "give", "buffer-2"));
+  REQUIRE(names<fb::Contractor>(twice) == Names{"REPLY"});
+  CHECK(fb::get<bool>(twice[0].data, "confirmed"));
+
+  // The first confirmation, late, settles the call.
+  fb::Data late = taken[0].data;
+  late["resource_id"] = std::string("buffer-2");
+  const auto awarded = twin.send("AWARD_REPLY", late);
+  REQUIRE(names<fb::Negotiator>(awarded) == Names{"AWARDED"});
+  CHECK(fb::get<std::string>(awarded[0].data, "resource_id") == "buffer-2");
+  CHECK(twin.block().open_calls() == 0);
+}
+
 TEST_CASE("negotiator: the awarded resource disappears before it confirms: the next bid wins", "[fb][negotiation]") {
   fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", fb::NegotiationSettings{});
   f.send("CAPABILITY", capability("station-1", "host"));
