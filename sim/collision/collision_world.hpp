@@ -65,8 +65,10 @@ class MovingBody {
   // mesh; a concave one-piece mesh is checked by its hull and then, near contact, by its
   // triangles. Triangles are a surface: two faces that overlap flat, where no triangles
   // cross, go unseen (the finished product's interference check, which is volumetric,
-  // catches those at the final poses).
-  void add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin);
+  // catches those at the final poses). Where its triangles touch or cross a concave static
+  // part's, points of each in the other's volume tell the depth (sim/mesh/solid.hpp).
+  void add_mesh(const std::string& member, std::shared_ptr<const TriangleMesh> mesh, const Pose& offset, double margin);
+  void add_mesh(const std::string& member, const TriangleMesh& mesh, const Pose& offset, double margin);  // a copy
   void add_box(const std::string& member, const Eigen::Vector3d& half_extents, const Pose& offset, double margin);
   // Largest distance of any point from the body's origin: bounds how far points move when
   // it turns.

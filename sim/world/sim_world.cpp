@@ -104,7 +104,7 @@ MoveResult SimWorld::move(const MoveRequest& request) {
   for (const Body* b : moving) {
     const Pose offset = offsets.emplace_back(start.inverse() * b->spec.pose);
     if (b->mesh) {
-      compound.add_mesh(b->spec.id, *b->mesh, offset, margin);
+      compound.add_mesh(b->spec.id, b->mesh, offset, margin);
     } else if (!b->spec.half_extents.isZero()) {
       compound.add_box(b->spec.id, b->spec.half_extents, offset, margin);
     }

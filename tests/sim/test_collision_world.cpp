@@ -137,6 +137,36 @@ TEST_CASE("a one-piece concave part that moves is checked by its triangles, not 
   }
 }
 
+TEST_CASE("a concave ring set into a concave ring is caught by volume, however fine its triangles; resting on it, not",
+          "[collision][exact]") {
+  // Triangle against triangle, the way out of two crossing thin triangles is short: a ring
+  // 4 mm into another (each 5 mm tall) came out clear at 1 000 triangles and at 50 000.
+  for (const int segments : {125, 1250}) {
+    INFO(segments * 8 << " triangles per ring");
+    sim::CollisionWorld world;
+    world.add_static_mesh("ring below", std::make_shared<sim::TriangleMesh>(test::tube_mesh(segments, 0.020, 0.010, 0.005)),
+                          at(0, 0, 0));
+    sim::MovingBody ring;
+    ring.add_mesh("part", test::tube_mesh(segments, 0.02001, 0.010, 0.005), sim::Pose::Identity(),
+                  world.options().shape_margin);
+    CHECK_FALSE(world.penetration(ring, at(0, 0.005, 0)));  // resting on it
+    for (const double into : {0.0004, 0.002}) {
+      INFO(into * 1000 << " mm into it");
+      const auto hit = world.penetration(ring, at(0, 0.005 - into, 0));
+      REQUIRE(hit);
+      CHECK(hit->body_name == "ring below");
+      CHECK(hit->member == "part");
+      CHECK(hit->depth > world.options().contact_tolerance);
+      CHECK(hit->depth <= into + 1e-4);
+    }
+    const auto beside = world.penetration(ring, at(0.039, 0.0, 0));  // 1 mm into its side
+    REQUIRE(beside);
+    CHECK(beside->depth > world.options().contact_tolerance);  // a least depth: the first point found past it
+    CHECK(beside->depth <= 0.001 + 1e-4);
+    CHECK_FALSE(world.penetration(ring, at(0.0402, 0.0, 0)));  // 0.2 mm beside it
+  }
+}
+
 TEST_CASE("clearance: how near a body comes, box to box, peg to hole and frame to post", "[collision][margin]") {
   sim::CollisionWorld world;
   world.add_static_box("wall", {0.005, 0.05, 0.05}, at(0, 0, 0));

@@ -102,7 +102,7 @@ std::vector<Grasp> AssemblyScene::grasps(PartIndex part, const Vec3& direction) 
 HeldPart AssemblyScene::hold(PartIndex part, const Grasp& grasp) const {
   const double margin = world_.options().shape_margin;
   HeldPart held;
-  if (const auto& mesh = product_.meshes[part]) held.with_arm.add_mesh("part", *mesh, Pose::Identity(), margin);
+  if (const auto& mesh = product_.meshes[part]) held.with_arm.add_mesh("part", mesh, Pose::Identity(), margin);
   for (const auto& box : fb::gripper_boxes(gripper_, grasp.opening)) {
     const std::string member = box.name.rfind("finger", 0) == 0 ? "finger" : box.name;
     held.with_arm.add_box(member, box.half_extents, grasp.gripper * box.pose, margin);

@@ -1,0 +1,82 @@
+#include "sim/mesh/solid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <CGAL/boost/graph/helpers.h>
+
+namespace sim {
+namespace {
+
+constexpr double kSampleSpacing = 2e-3;  // m, at most between surface samples
+constexpr int kMaxDivisions = 8;         // per triangle edge: large faces are sampled coarser
+
+}  // namespace
+
+// Where the point's nearest surface point is inside a face, the face's normal tells (the mesh
+// is closed and consistently wound: Surface_mesh accepted every face); at an edge or a
+// corner, a ray does (slower).
+bool Solid::contains(const SolidPoint& p) const {
+  if (!inside) return false;
+  const auto [nearest, face] = surface->closest_point_and_primitive(p);
+  return contains(p, nearest, face);
+}
+
+bool Solid::contains(const SolidPoint& p, const SolidPoint& nearest, Mesh::Face_index face) const {
+  const auto h = mesh.halfedge(face);
+  const SolidPoint &a = mesh.point(mesh.source(h)), &b = mesh.point(mesh.target(h)),
+                   &c = mesh.point(mesh.target(mesh.next(h)));
+  const SolidKernel::Vector_3 n = CGAL::cross_product(b - a, c - a);
+  const double area2 = n.squared_length();
+  if (area2 > 0) {
+    // Barycentric coordinates of the nearest point: all clearly above 0 inside the face.
+    const double u = CGAL::cross_product(c - b, nearest - b) * n / area2,
+                 v = CGAL::cross_product(a - c, nearest - c) * n / area2, w = 1 - u - v;
+    constexpr double kInside = 1e-6;
+    if (u > kInside && v > kInside && w > kInside) return orientation * ((p - nearest) * n) < 0;
+  }
+  return (*inside)(p) == CGAL::ON_BOUNDED_SIDE;
+}
+
+double Solid::depth(const Eigen::Vector3d& p, double tolerance) const {
+  if (!inside) return 0;
+  const SolidPoint q = solid_point(p);
+  const auto [nearest, face] = surface->closest_point_and_primitive(q);
+  const double distance = std::sqrt(CGAL::squared_distance(q, nearest));
+  return distance > tolerance && contains(q, nearest, face) ? distance : 0;
+}
+
+std::unique_ptr<Solid> solid_of(const TriangleMesh& source) {
+  auto s = std::make_unique<Solid>();
+  std::vector<Solid::Mesh::Vertex_index> vertices;
+  vertices.reserve(source.vertices.size());
+  for (const auto& v : source.vertices) {
+    vertices.push_back(s->mesh.add_vertex(solid_point(v)));
+    s->samples.push_back(v);
+  }
+  bool manifold = true;
+  for (const auto& t : source.triangles) {
+    if (s->mesh.add_face(vertices[t[0]], vertices[t[1]], vertices[t[2]]) == Solid::Mesh::null_face()) manifold = false;
+    const Eigen::Vector3d &a = source.vertices[t[0]], &b = source.vertices[t[1]], &c = source.vertices[t[2]];
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int n = std::clamp(static_cast<int>(std::ceil(longest / kSampleSpacing)), 1, kMaxDivisions);
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; i + j <= n; ++j) {
+        if ((i == 0 && j == 0) || i == n || j == n) continue;  // the corners are in already
+        s->samples.push_back(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n));
+      }
+    }
+  }
+  s->surface = std::make_unique<Solid::Tree>(faces(s->mesh).first, faces(s->mesh).second, s->mesh);
+  if (manifold && CGAL::is_closed(s->mesh)) {
+    s->inside = std::make_unique<Solid::SideOf>(*s->surface);
+    double volume = 0;  // signed: positive when wound outwards
+    for (const auto& t : source.triangles) {
+      volume += source.vertices[t[0]].dot(source.vertices[t[1]].cross(source.vertices[t[2]]));
+    }
+    s->orientation = volume < 0 ? -1 : 1;
+  }
+  return s;
+}
+
+}  // namespace sim

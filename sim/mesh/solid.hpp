@@ -1,0 +1,51 @@
+#pragma once
+// A closed mesh as a solid, in its own frame (metres): its surface for distances, what lies
+// inside it, and points over its surface. Volumes, not surfaces: two faces that overlap flat,
+// or a face pushed into a finely tessellated one, show as points of one inside the other,
+// where triangle against triangle sees only the shortest way out of two thin triangles.
+// Used by the finished product's interference check (twin/planning/interference.*) and by
+// the collision world's check of a concave part against a concave part.
+
+#include <memory>
+#include <vector>
+
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Surface_mesh.h>
+
+#include "sim/mesh/triangle_mesh.hpp"
+
+namespace sim {
+
+using SolidKernel = CGAL::Simple_cartesian<double>;
+using SolidPoint = SolidKernel::Point_3;
+
+struct Solid {
+  using Mesh = CGAL::Surface_mesh<SolidPoint>;
+  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<SolidKernel, CGAL::AABB_face_graph_triangle_primitive<Mesh>>>;
+  using SideOf = CGAL::Side_of_triangle_mesh<Mesh, SolidKernel>;
+
+  Mesh mesh;
+  std::unique_ptr<Tree> surface;
+  std::unique_ptr<SideOf> inside;  // null: the mesh is not closed, it has no inside
+  double orientation = 1;          // -1: its faces are wound inwards
+  // Its vertices, then points over each triangle at most 2 mm apart (coarser on large faces).
+  std::vector<Eigen::Vector3d> samples;
+
+  // Whether a point lies inside (false for a solid that has no inside); the second form for
+  // a closed solid, with the point's nearest surface point and its face.
+  bool contains(const SolidPoint& p) const;
+  bool contains(const SolidPoint& p, const SolidPoint& nearest, Mesh::Face_index face) const;
+  // How deep a point lies inside: its distance from the surface, where that is more than
+  // `tolerance` and it is inside; 0 otherwise.
+  double depth(const Eigen::Vector3d& p, double tolerance) const;
+};
+
+inline SolidPoint solid_point(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+std::unique_ptr<Solid> solid_of(const TriangleMesh& mesh);
+
+}  // namespace sim
