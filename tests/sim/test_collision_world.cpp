@@ -137,7 +137,7 @@ TEST_CASE("a one-piece concave part that moves is checked by its triangles, not 
   }
 }
 
-TEST_CASE("a concave ring set into a concave ring is caught by volume, however fine its triangles; resting on it, not",
+TEST_CASE("a concave ring set into a concave ring is caught by volume, however fine its triangles, and one resting on it is not",
           "[collision][exact]") {
   // Triangle against triangle, the way out of two crossing thin triangles is short: a ring
   // 4 mm into another (each 5 mm tall) came out clear at 1 000 triangles and at 50 000.
