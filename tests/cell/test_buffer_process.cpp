@@ -25,7 +25,8 @@ namespace {
 
 constexpr int kDomain = 181;
 
-// What the test's readers saw, guarded for the listener threads.
+// What the test's readers saw, guarded for the listener threads: the test thread reads
+// copies, since a listener may add (and reallocate) while it checks.
 struct Seen {
   std::mutex mutex;
   std::condition_variable changed;
@@ -45,6 +46,18 @@ struct Seen {
       f();
     }
     changed.notify_all();
+  }
+  std::vector<cell::CommandEvent> events_now() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return events;
+  }
+  cell::Capability last_capability() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return capabilities.back();
+  }
+  std::string first_gone() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return gone.front();
   }
 };
 
@@ -97,9 +110,9 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
                                                                dds::TopicKind::events);
 
   REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
-  CHECK(seen.capabilities.back().resource_id() == "buffer-1");
-  CHECK(seen.capabilities.back().kind() == "buffer");
-  CHECK(stock_of(seen.capabilities.back(), "SquarePeg") == 1);
+  CHECK(seen.last_capability().resource_id() == "buffer-1");
+  CHECK(seen.last_capability().kind() == "buffer");
+  CHECK(stock_of(seen.last_capability(), "SquarePeg") == 1);
   REQUIRE(commands.wait_for_readers(1, std::chrono::seconds(10)));
   std::string why;
   const std::string award = test::hire(participant, "buffer-1", "o1", "give", {"", "SquarePeg", 1}, &why);
@@ -110,36 +123,40 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   // a give that names nobody is refused, and the part stays.
   REQUIRE(commands.write(give("c0", "SquarePeg", award, "")));
   REQUIRE(seen.wait([&] { return !seen.events.empty(); }));
-  CHECK(seen.events[0].command_id() == "c0");
-  CHECK(seen.events[0].state() == cell::REJECTED);
-  CHECK(seen.events[0].reason() == "destination: empty");
+  auto got = seen.events_now();
+  CHECK(got[0].command_id() == "c0");
+  CHECK(got[0].state() == cell::REJECTED);
+  CHECK(got[0].reason() == "destination: empty");
   seen.add([&] { seen.events.clear(); });
 
   REQUIRE(commands.write(give("c1", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 2; }));
-  CHECK(seen.events[0].command_id() == "c1");
-  CHECK(seen.events[0].state() == cell::ACCEPTED);
-  CHECK(seen.events[1].state() == cell::SUCCEEDED);
+  got = seen.events_now();
+  CHECK(got[0].command_id() == "c1");
+  CHECK(got[0].state() == cell::ACCEPTED);
+  CHECK(got[1].state() == cell::SUCCEEDED);
   REQUIRE(seen.wait([&] { return stock_of(seen.capabilities.back(), "SquarePeg") == 0; }));
 
   REQUIRE(commands.write(give("c2", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 4; }));
-  CHECK(seen.events[2].state() == cell::ACCEPTED);
-  CHECK(seen.events[3].command_id() == "c2");
-  CHECK(seen.events[3].state() == cell::ABORTED);
-  CHECK(seen.events[3].reason() == "buffer buffer-1 has no SquarePeg free for order o1");
+  got = seen.events_now();
+  CHECK(got[2].state() == cell::ACCEPTED);
+  CHECK(got[3].command_id() == "c2");
+  CHECK(got[3].state() == cell::ABORTED);
+  CHECK(got[3].reason() == "buffer buffer-1 has no SquarePeg free for order o1");
 
   // The same command again (its sender heard nothing): not carried out twice, its last
   // event comes again.
   REQUIRE(commands.write(give("c2", "SquarePeg", award)));
   REQUIRE(seen.wait([&] { return seen.events.size() >= 5; }));
-  CHECK(seen.events[4].command_id() == "c2");
-  CHECK(seen.events[4].state() == cell::ABORTED);
-  CHECK(seen.events[4].reason() == "buffer buffer-1 has no SquarePeg free for order o1");
+  got = seen.events_now();
+  CHECK(got[4].command_id() == "c2");
+  CHECK(got[4].state() == cell::ABORTED);
+  CHECK(got[4].reason() == "buffer buffer-1 has no SquarePeg free for order o1");
 
   CHECK(buffer.stop() == 0);
   REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));
-  CHECK(seen.gone.front() == "buffer-1");
+  CHECK(seen.first_gone() == "buffer-1");
 }
 
 TEST_CASE("buffer process killed hard: its capability goes when the liveliness lease runs out", "[process][buffer]") {
@@ -151,13 +168,13 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
   auto participant = dds::make_participant("test-twin", {domain, true, {}});
   const auto capabilities = watch_capabilities(participant, seen);
   REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
-  CHECK(stock_of(seen.capabilities.back(), "RoundPeg") == 3);
+  CHECK(stock_of(seen.last_capability(), "RoundPeg") == 3);
 
   const auto killed = std::chrono::steady_clock::now();
   buffer.kill_hard();
   REQUIRE(seen.wait([&] { return !seen.gone.empty(); }));
   const double noticed_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
-  CHECK(seen.gone.front() == "buffer-2");
+  CHECK(seen.first_gone() == "buffer-2");
   CHECK(noticed_after < 5.0);  // bound, not a speed target: the lease is 0.5 s
   test::clean_stale_dds_segments();  // what the killed process left behind
 }
@@ -192,12 +209,12 @@ TEST_CASE("a buffer that restarts answers the command its process had taken on A
                        [](const cell::CommandEvent& e) { return e.command_id() == "o1/give-1"; });
   };
   REQUIRE(seen.wait(answered));
-  for (const auto& e : seen.events) {
+  for (const auto& e : seen.events_now()) {
     if (e.command_id() != "o1/give-1") continue;
     CHECK(e.state() == cell::ABORTED);
     CHECK(e.reason() == fb::restarted_reason("buffer-1"));
   }
-  CHECK(stock_of(seen.capabilities.back(), "SquarePeg") == 2);  // nothing given
+  CHECK(stock_of(seen.last_capability(), "SquarePeg") == 2);  // nothing given
   CHECK(buffer.stop() == 0);
   std::filesystem::remove_all(dir);
 }
