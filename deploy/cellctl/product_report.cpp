@@ -15,14 +15,15 @@ twin::Vec3 xyz_degrees(const twin::Quat& q) {
 
 namespace {
 
-// Mesh file -> (what loading repaired or found, the parts that use it), for the files with any.
+// Mesh file -> (what loading repaired, found or simplified, the parts that use it), for the files with any.
 std::map<std::string, std::pair<std::string, std::vector<std::string>>> mesh_repairs(const twin::LoadedProduct& loaded) {
   std::map<std::string, std::pair<std::string, std::vector<std::string>>> out;
   for (std::size_t i = 0; i < loaded.meshes.size(); ++i) {
     const auto& part = loaded.product.parts()[i];
-    if (!loaded.meshes[i] || !loaded.meshes[i]->repairs.any()) continue;
+    const std::string report = loaded.meshes[i] ? sim::loading_report(*loaded.meshes[i]) : "";
+    if (report.empty()) continue;
     auto& entry = out[part.mesh->file.filename().string()];
-    entry.first = loaded.meshes[i]->repairs.describe();
+    entry.first = report;
     entry.second.push_back(part.name);
   }
   return out;

@@ -44,13 +44,15 @@ std::unique_ptr<btConvexHullShape> hull_through(const TriangleMesh& mesh, const 
 }
 
 // The hull of a mesh's piece, of the corners loading found (mesh.hull_corners): a bore's or
-// a stud's inner vertices would only slow every support query of GJK.
+// a stud's inner vertices would only slow every support query of GJK. A convex mesh of many
+// corners: its simplified hull (triangle_mesh.hpp), for the same reason.
 std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t piece, double margin) {
+  if (hull_simplified(mesh)) return hull_through(mesh, mesh.coarse_corners, margin + mesh.coarse_margin);
   return hull_through(mesh, piece < mesh.hull_corners.size() ? mesh.hull_corners[piece] : mesh.pieces[piece], margin);
 }
 
-// The coarse hull of a concave one-piece mesh (triangle_mesh.hpp): a few hull corners grown
-// to hold the rest, or the hull itself.
+// The coarse hull of a one-piece mesh (triangle_mesh.hpp): a few hull corners grown to hold
+// the rest, or the hull itself.
 std::unique_ptr<btConvexHullShape> coarse_hull_of(const TriangleMesh& mesh, double margin) {
   if (mesh.coarse_corners.empty()) return hull_of(mesh, 0, margin);
   return hull_through(mesh, mesh.coarse_corners, margin + mesh.coarse_margin);

@@ -11,6 +11,7 @@
 #include <limits>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 
@@ -182,7 +183,7 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
 void make_coarse_hull(TriangleMesh& mesh) {
   mesh.coarse_corners.clear();
   mesh.coarse_margin = 0;
-  if (mesh.convex || mesh.pieces.size() != 1 || mesh.hull_corners.size() != 1) return;
+  if (mesh.pieces.size() != 1 || mesh.hull_corners.size() != 1) return;
   const auto& corners = mesh.hull_corners[0];
   if (corners.size() <= kCoarseCorners) return;
   // Farthest-point sampling: each next corner the one farthest from those taken.
@@ -217,6 +218,22 @@ void make_coarse_hull(TriangleMesh& mesh) {
   }
   // A little over, for GJK's own tolerance.
   mesh.coarse_margin = outside / 1000 * 1.01 + 1e-6;
+  if (mesh.convex && mesh.coarse_margin > kSimplifiedHullGrowth) {  // a sphere: too round for 256
+    mesh.coarse_corners.clear();
+    mesh.coarse_margin = 0;
+  }
+}
+
+std::string loading_report(const TriangleMesh& mesh) {
+  std::string out = mesh.repairs.describe();
+  if (hull_simplified(mesh)) {
+    char growth[32];
+    std::snprintf(growth, sizeof growth, "%.4f", mesh.coarse_margin * 1000);
+    out += (out.empty() ? "" : "; ") + std::string("its collision hull simplified from ") +
+           std::to_string(mesh.hull_corners.front().size()) + " to " + std::to_string(mesh.coarse_corners.size()) +
+           " corners, at most " + growth + " mm larger";
+  }
+  return out;
 }
 
 std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh) {

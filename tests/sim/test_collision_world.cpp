@@ -167,6 +167,52 @@ TEST_CASE("a concave ring set into a concave ring is caught by volume, however f
   }
 }
 
+TEST_CASE("a convex pin of many corners is checked by a hull of few, at most 0.01 mm larger, moving or standing",
+          "[collision][exact]") {
+  const auto ring = std::make_shared<sim::TriangleMesh>(test::tube_mesh(1250, 0.020, 0.010, 0.005));
+  for (const double radius : {0.0098, 0.0104}) {  // a 0.2 mm clearance fit, a 0.4 mm interference
+    INFO("pin " << radius * 2000 << " mm across");
+    sim::TriangleMesh pin = test::tube_mesh(6000, radius, 0, 0.005);  // 36 000 triangles
+    pin.convex = sim::is_convex(pin);  // and the rest of what loading finds
+    pin.hull_corners = sim::hull_corners(pin);
+    sim::make_coarse_hull(pin);
+    REQUIRE(pin.convex);
+    REQUIRE(sim::hull_simplified(pin));
+    CHECK(pin.coarse_corners.size() == sim::kCoarseCorners);
+    CHECK(pin.coarse_margin <= sim::kSimplifiedHullGrowth);
+    CHECK_THAT(sim::loading_report(pin),
+               Catch::Contains("its collision hull simplified from ") && Catch::Contains(" to 256 corners, at most 0.0"));
+    sim::TriangleMesh exact_pin = pin;
+    exact_pin.coarse_corners.clear();
+    exact_pin.coarse_margin = 0;
+    CHECK(sim::loading_report(exact_pin).empty());
+
+    sim::CollisionWorld world;
+    world.add_static_mesh("ring", ring, sim::Pose::Identity());
+    const auto depth_of = [&](const sim::TriangleMesh& mesh) {
+      sim::MovingBody body;
+      body.add_mesh("pin", mesh, sim::Pose::Identity(), world.options().shape_margin);
+      const auto hit = world.penetration(body, sim::Pose::Identity());
+      return hit ? hit->depth : 0.0;
+    };
+    const double simplified = depth_of(pin), exact = depth_of(exact_pin);
+    if (radius < 0.010) {
+      CHECK(simplified == 0);
+      CHECK(exact == 0);
+    } else {
+      CHECK(exact == Approx(0.0005).margin(1e-4));  // 0.4 mm and the two shapes' margins
+      CHECK(simplified >= exact);  // the simplified hull only grows
+      CHECK(simplified <= exact + sim::kSimplifiedHullGrowth);
+    }
+    // The pin standing, the ring coming down onto it.
+    sim::CollisionWorld standing;
+    standing.add_static_mesh("pin", std::make_shared<sim::TriangleMesh>(pin), sim::Pose::Identity());
+    sim::MovingBody coming;
+    coming.add_mesh("ring", ring, sim::Pose::Identity(), standing.options().shape_margin);
+    CHECK(bool(standing.penetration(coming, sim::Pose::Identity())) == (radius > 0.010));
+  }
+}
+
 TEST_CASE("clearance: how near a body comes, box to box, peg to hole and frame to post", "[collision][margin]") {
   sim::CollisionWorld world;
   world.add_static_box("wall", {0.005, 0.05, 0.05}, at(0, 0, 0));

@@ -295,16 +295,19 @@ class Search {
     }
   }
 
-  // What loading repaired or found wrong in each mesh file, once per file.
+  // What loading repaired or found wrong in each mesh file, and what the check simplified,
+  // once per file.
   void report_meshes() {
     std::map<const sim::TriangleMesh*, std::vector<std::string>> users;
     for (PartIndex p = 0; p < product_.meshes.size(); ++p) {
-      if (product_.meshes[p] && product_.meshes[p]->repairs.any()) users[product_.meshes[p].get()].push_back(name(p));
+      if (product_.meshes[p] && !sim::loading_report(*product_.meshes[p]).empty()) {
+        users[product_.meshes[p].get()].push_back(name(p));
+      }
     }
     for (const auto& [mesh, parts] : users) {
       const auto& part = product_.product.parts()[*product_.product.find_part_by_name(parts.front())];
       plan_.findings.push_back({"mesh", part.mesh->file.filename().string() + " (" + join(parts) + "): " +
-                                            mesh->repairs.describe(), parts});
+                                            sim::loading_report(*mesh), parts});
     }
   }
 
