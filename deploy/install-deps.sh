@@ -9,7 +9,9 @@ packages=(
   libassimp-dev libtinygltf-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libyaml-cpp-dev
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
   libbenchmark-dev libsqlite3-dev sqlite3 libcgal-dev
-  libfcl-dev     # only for bench_collision_libraries: our collision check against FCL's
+  libfcl-dev libopenvdb-dev libboost-iostreams-dev libbullet-extras-dev  # only for bench_collision_libraries:
+                 # our check against FCL's, OpenVDB's distance fields (its CMake module wants Boost
+                 # iostreams, which the package does not pull) and Bullet's HACD decomposition
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
   chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
