@@ -167,6 +167,29 @@ TEST_CASE("a concave ring set into a concave ring is caught by volume, however f
   }
 }
 
+TEST_CASE("a concave ring over a concave ring is nearest where it comes nearest, held flat or tilted",
+          "[collision][exact]") {
+  // Pairs of triangles whose boxes lie as far apart as the nearest pair so far are not asked:
+  // this checks that no nearer pair is left out with them.
+  for (const int segments : {100, 1000}) {  // even: a corner lies at 180 degrees, where the tilt is lowest
+    INFO(segments * 8 << " triangles per ring");
+    sim::CollisionWorld world;
+    world.add_static_mesh("ring below", std::make_shared<sim::TriangleMesh>(test::tube_mesh(segments, 0.020, 0.010, 0.005)),
+                          at(0, 0, 0));
+    sim::MovingBody ring;
+    ring.add_mesh("part", test::tube_mesh(segments, 0.020, 0.010, 0.005), sim::Pose::Identity(), world.options().shape_margin);
+    const auto flat = world.nearest(ring, at(0, 0.006, 0), 0.01);
+    REQUIRE(flat);
+    CHECK(flat->distance == Approx(0.001).margin(1e-6));
+    const double tilt = 2 * M_PI / 180;
+    sim::Pose tilted = at(0, 0.008, 0);
+    tilted.linear() = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const auto near = world.nearest(ring, tilted, 0.01);
+    REQUIRE(near);
+    CHECK(near->distance == Approx(0.003 - 0.020 * std::sin(tilt)).margin(1e-6));  // its rim at -x
+  }
+}
+
 TEST_CASE("a convex pin of many corners is checked by a hull of few, at most 0.01 mm larger, moving or standing",
           "[collision][exact]") {
   const auto ring = std::make_shared<sim::TriangleMesh>(test::tube_mesh(1250, 0.020, 0.010, 0.005));
