@@ -165,6 +165,20 @@ void BM_Fcl_distance(benchmark::State& state) {
   state.counters["distance_mm"] = query() * 1000;
 }
 
+// The deepest penetration Bullet reports between two objects (its units), or 0.
+double deepest_contact(btCollisionWorld& world, btCollisionObject& a, btCollisionObject& b) {
+  struct Deepest : btCollisionWorld::ContactResultCallback {
+    double depth = 0;
+    btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int,
+                             const btCollisionObjectWrapper*, int, int) override {
+      depth = std::max(depth, double(-cp.getDistance()));
+      return 0;
+    }
+  } callback;
+  world.contactPairTest(&a, &b, callback);
+  return callback.depth;
+}
+
 // Bullet's GImpact: both meshes as btGImpactMeshShape (a box tree over each one's triangles,
 // triangle pairs by SAT), in millimetres and with the margin the cell gives every shape, as
 // ours; the deepest contact point it reports, which counts beyond the 0.3 mm tolerance.
@@ -202,19 +216,7 @@ struct GImpactCase {
     at.setOrigin(btVector3(c.pose.translation().x(), c.pose.translation().y(), c.pose.translation().z()) * 1000);
     moving_object.setWorldTransform(at);
   }
-  // The deepest penetration (mm), or 0.
-  double deepest() {
-    struct Deepest : btCollisionWorld::ContactResultCallback {
-      double depth = 0;
-      btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int,
-                               const btCollisionObjectWrapper*, int, int) override {
-        depth = std::max(depth, double(-cp.getDistance()));
-        return 0;
-      }
-    } callback;
-    world.contactPairTest(&moving_object, &base_object, callback);
-    return callback.depth;
-  }
+  double deepest() { return deepest_contact(world, moving_object, base_object); }
   GImpactMesh base, moving;
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
@@ -347,16 +349,7 @@ void BM_Hacd(benchmark::State& state) {
     btTransform at = btTransform::getIdentity();
     at.setOrigin(btVector3(0, btScalar(pin.pose.translation().y() * 1000), 0));
     moving.setWorldTransform(at);
-    struct Deepest : btCollisionWorld::ContactResultCallback {
-      double depth = 0;
-      btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int,
-                               const btCollisionObjectWrapper*, int, int) override {
-        depth = std::max(depth, double(-cp.getDistance()));
-        return 0;
-      }
-    } callback;
-    world.contactPairTest(&moving, &base, callback);
-    return callback.depth;
+    return deepest_contact(world, moving, base);
   };
   state.counters["pieces"] = static_cast<double>(hacd.GetNClusters());
   btVector3 low, high;  // the pieces' box against the ring's: where HACD put them
