@@ -132,6 +132,7 @@ std::shared_ptr<TriangleMesh> read_entry(const std::filesystem::path& path) {
     }
   }
   if (m->hull_corners.size() != m->pieces.size() || coarse.size() != 1) return nullptr;
+  if (!coarse.front().empty() && m->pieces.size() != 1) return nullptr;  // a coarse hull is of one piece
   m->coarse_corners = std::move(coarse.front());
   if (!get(in, m->coarse_margin) || !std::isfinite(m->coarse_margin) || m->coarse_margin < 0) return nullptr;
   Eigen::Vector3d lo, hi;

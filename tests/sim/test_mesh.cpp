@@ -161,6 +161,25 @@ TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores
     f.write(reinterpret_cast<const char*>(&far), sizeof far);
   }
   same(*sim::MeshDiskCache(folder).load(file, 1e-3));
+  // So is one with a simplified hull and no pieces (its hull's corners would be asked of none).
+  {
+    std::ifstream in(entry, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    const std::size_t lists = 8 + 4 + 8 + 8 * 3 * 8 + 8 + 12 * 3 * 4;  // up to the piece count
+    const std::size_t corner_list = 8 + 8 + 8 * 4;  // one list of the block's 8 corners
+    REQUIRE(loaded->pieces.size() == 1);
+    REQUIRE(loaded->coarse_corners.empty());
+    std::string damaged = bytes.substr(0, lists);
+    const auto put = [&](std::uint64_t n, std::size_t size) { damaged.append(reinterpret_cast<const char*>(&n), size); };
+    put(0, 8);  // no pieces
+    put(0, 8);  // no hull corners
+    put(1, 8);  // coarse corners: the 8 of the block
+    put(8, 8);
+    for (std::uint32_t v = 0; v < 8; ++v) put(v, 4);
+    damaged += bytes.substr(lists + 2 * corner_list + 16);
+    std::ofstream(entry, std::ios::binary | std::ios::trunc) << damaged;
+  }
+  same(*sim::MeshDiskCache(folder).load(file, 1e-3));
   // Entries are named by the SHA-256 of the content (64 hex digits), not by a hash one can
   // collide on purpose: meshes come from OEMs.
   CHECK(std::regex_match(entry.filename().string(), std::regex("[0-9a-f]{64}-.*\\.mesh")));
