@@ -9,6 +9,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <tuple>
 
 #include <btBulletCollisionCommon.h>
 #include <BulletCollision/CollisionShapes/btTriangleShape.h>
@@ -35,12 +36,20 @@ btTransform to_bullet(const Pose& pose) {
                      to_bullet(Eigen::Vector3d(pose.translation())));
 }
 
+// A hull grown beyond its margin to hold corners it leaves out (a simplified hull) keeps that
+// growth (Bullet units) in its user index, in steps of a millionth: a distance adds back only
+// the margin that lies beyond the mesh, and is never more than the mesh's own.
+constexpr double kHeldSteps = 1e6;
+void set_held(btCollisionShape& shape, double held) { shape.setUserIndex(static_cast<int>(std::lround(held * kHeldSteps))); }
+double held_of(const btCollisionShape* shape) { return std::max(0, shape->getUserIndex()) / kHeldSteps; }
+
 std::unique_ptr<btConvexHullShape> hull_through(const TriangleMesh& mesh, const std::vector<std::uint32_t>& points,
-                                                double margin) {
+                                                double margin, double held = 0) {
   auto hull = std::make_unique<btConvexHullShape>();
   for (auto index : points) hull->addPoint(to_bullet(mesh.vertices[index]), false);
   hull->recalcLocalAabb();
-  hull->setMargin(margin * kUnitsPerMetre);
+  hull->setMargin((margin + held) * kUnitsPerMetre);
+  set_held(*hull, held * kUnitsPerMetre);
   return hull;
 }
 
@@ -48,7 +57,7 @@ std::unique_ptr<btConvexHullShape> hull_through(const TriangleMesh& mesh, const 
 // a stud's inner vertices would only slow every support query of GJK. A convex mesh of many
 // corners: its simplified hull (triangle_mesh.hpp), for the same reason.
 std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t piece, double margin) {
-  if (hull_simplified(mesh)) return hull_through(mesh, mesh.coarse_corners, margin + mesh.coarse_margin);
+  if (hull_simplified(mesh)) return hull_through(mesh, mesh.coarse_corners, margin, mesh.coarse_margin);
   return hull_through(mesh, piece < mesh.hull_corners.size() ? mesh.hull_corners[piece] : mesh.pieces[piece], margin);
 }
 
@@ -56,7 +65,7 @@ std::unique_ptr<btConvexHullShape> hull_of(const TriangleMesh& mesh, std::size_t
 // the rest, or the hull itself.
 std::unique_ptr<btConvexHullShape> coarse_hull_of(const TriangleMesh& mesh, double margin) {
   if (mesh.coarse_corners.empty()) return hull_of(mesh, 0, margin);
-  return hull_through(mesh, mesh.coarse_corners, margin + mesh.coarse_margin);
+  return hull_through(mesh, mesh.coarse_corners, margin, mesh.coarse_margin);
 }
 
 constexpr int kCoarse = 1;  // user index 2 of a static body's hull that stands before its BVH
@@ -115,9 +124,11 @@ struct DeepestContact : btCollisionWorld::ContactResultCallback {
   }
 };
 
-// A box holds its margin inside its extents; hulls and triangles are grown by theirs.
+// How far a shape's surface lies beyond its corners, where its mesh does not: a box holds its
+// margin inside its extents; hulls and triangles are grown by theirs (less what a simplified
+// hull holds: set_held).
 double grown_by(const btCollisionShape* shape) {
-  return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin();
+  return shape->getShapeType() == BOX_SHAPE_PROXYTYPE ? 0 : shape->getMargin() - held_of(shape);
 }
 
 // The corners of a convex child (box, hull or triangle) at `offset` and the same corners
@@ -232,17 +243,18 @@ void static_pieces(const btCollisionShape* shape, const btTransform& world, cons
 // one per triangle, and a hull allocated for each was a tenth of a plan of a ring stack.
 class ReusableHull : public btConvexHullShape {
  public:
-  void set(const btVector3* points, int count, btScalar margin) {
+  void set(const btVector3* points, int count, btScalar margin, btScalar held) {
     m_unscaledPoints.resize(count);
     std::copy(points, points + count, &m_unscaledPoints[0]);
     setMargin(margin);
+    set_held(*this, held);
     recalcLocalAabb();
   }
 };
 
 // A convex piece of a moving body, where it stands (world), and the member it belongs to.
 // The piece is `shape`, or (null) the hull of `count` corners from `first` on in the list that
-// comes with it, with that margin.
+// comes with it, with that margin (of which `held` holds corners left out: set_held).
 struct MovingPiece {
   const btConvexShape* shape;
   btTransform at;
@@ -250,6 +262,7 @@ struct MovingPiece {
   std::size_t first = 0;
   int count = 0;
   btScalar margin = 0;
+  btScalar held = 0;
   // A piece that closes on its seat along `ahead` (world, unit): static pieces wholly beyond
   // `ends_at` along it are not asked.
   btVector3 ahead{0, 0, 0};
@@ -556,7 +569,7 @@ struct CollisionWorld::Impl {
     ReusableHull hull;
     for (MovingPiece piece : pieces) {
       if (!piece.shape) {
-        hull.set(&corners[piece.first], piece.count, piece.margin);
+        hull.set(&corners[piece.first], piece.count, piece.margin, piece.held);
         piece.shape = &hull;
       }
       btVector3 box_lo, box_hi, surface_lo, surface_hi;
@@ -654,12 +667,12 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   // Where a concave moving member's triangles touch or cross a concave static body's: how deep
   // the corners and middles of each such triangle lie in the other's volume (a corner of a
   // finely tessellated ring's wall 4 mm into the ring below, whose triangles GJK/EPA let go
-  // 0.1 mm apart). Closed meshes only: an open one has no inside. Each triangle once per pair;
-  // its corners and its middle. The first point deeper than the tolerance ends the search: its
-  // depth is then a least one (asking them all took 23 s for a ring of 50 000 triangles 0.4 mm
-  // into another).
-  std::set<std::pair<std::size_t, int>> moving_done;
-  std::set<std::pair<BodyId, int>> static_done;
+  // 0.1 mm apart). Closed meshes only: an open one has no inside. Each triangle once per member
+  // and body (one that rests on a part may go into the next): its corners and its middle. The
+  // first point deeper than the tolerance ends the search: its depth is then a least one (asking
+  // them all took 23 s for a ring of 50 000 triangles 0.4 mm into another).
+  std::set<std::tuple<std::size_t, int, BodyId>> moving_done;  // (member, its triangle, the body asked)
+  std::set<std::tuple<BodyId, int, std::size_t>> static_done;  // (body, its triangle, the member asked)
   const auto inside_other = [&](const std::vector<DeepestContact::Crossing>& crossings) -> std::optional<Contact> {
     std::optional<Contact> hit;
     const auto consider = [&](double depth, const Eigen::Vector3d& where, BodyId b, const std::string& member) {
@@ -690,7 +703,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
         const Eigen::Vector3d &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
         return std::array<Eigen::Vector3d, 4>{a, b, c, (a + b + c) / 3};
       };
-      if (moving_done.insert({child, triangle}).second && static_cast<std::size_t>(triangle) < moving_mesh.triangles.size()) {
+      if (moving_done.insert({child, triangle, crossing.body}).second && static_cast<std::size_t>(triangle) < moving_mesh.triangles.size()) {
         const Solid& into = impl_->solid_of_body(fixed);
         const Pose to_fixed = fixed.pose.inverse() * member_pose;
         for (const auto& p : points_of(moving_mesh, static_cast<std::size_t>(triangle))) {
@@ -698,7 +711,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
           if (hit) return hit;
         }
       }
-      if (static_done.insert({crossing.body, crossing.triangle}).second && crossing.triangle >= 0 &&
+      if (static_done.insert({crossing.body, crossing.triangle, child}).second && crossing.triangle >= 0 &&
           static_cast<std::size_t>(crossing.triangle) < fixed_mesh.triangles.size()) {
         const Solid& into = moving.solid(child);
         const Pose to_member = member_pose.inverse() * fixed.pose;
@@ -801,7 +814,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
   std::vector<MovingPiece> pieces;
   std::vector<btVector3> points;  // a piece's corners and the same shifted, in the body's frame
   std::vector<btVector3> in_world;
-  const auto consider = [&](const std::string& member, btScalar margin) {
+  const auto consider = [&](const std::string& member, btScalar margin, btScalar held) {
     if (points.empty()) return;
     in_world.clear();
     btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
@@ -810,7 +823,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
       lo.setMin(in_world.back());
       hi.setMax(in_world.back());
     }
-    MovingPiece piece{nullptr, at, &member, corners.size(), static_cast<int>(points.size()), margin};
+    MovingPiece piece{nullptr, at, &member, corners.size(), static_cast<int>(points.size()), margin, held};
     if (member == closing && ahead.length2() > 0) {
       piece.ahead = ahead;
       piece.ends_at = -BT_LARGE_FLOAT;
@@ -834,7 +847,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
     const auto& triangles = moving.triangles_of_child[static_cast<std::size_t>(i)];
     if (triangles.empty()) {
       swept_corners(*coarse.getChildShape(i), offset, local_shift, points);
-      consider(member, coarse.getChildShape(i)->getMargin());
+      consider(member, coarse.getChildShape(i)->getMargin(), static_cast<btScalar>(held_of(coarse.getChildShape(i))));
       continue;
     }
     for (const auto& t : triangles) {
@@ -843,7 +856,7 @@ std::optional<Clearance> CollisionWorld::nearest_translating(const MovingBody& b
         points.push_back(offset * corner);
         points.push_back(offset * corner + local_shift);
       }
-      consider(member, static_cast<btScalar>(moving.margin));
+      consider(member, static_cast<btScalar>(moving.margin), 0);
     }
   }
   return impl_->nearest_of(pieces, near.objects, threshold, counts, corners);

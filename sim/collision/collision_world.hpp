@@ -96,7 +96,9 @@ class CollisionWorld {
   BodyId add_static_box(const std::string& name, const Eigen::Vector3d& half_extents, const Pose& pose);
   void remove(BodyId body);
 
-  // The deepest penetration of the body at a pose, if deeper than the tolerance.
+  // A penetration of the body at a pose deeper than the tolerance, if there is one: the deepest
+  // where pieces meet as convex shapes; where a concave member goes into a concave body, the
+  // first point found past the tolerance, whose depth is then a least one.
   std::optional<Contact> penetration(const MovingBody& body, const Pose& pose) const;
   // The first collision while moving from one pose to another, translating and turning
   // together (slerp), sampled so that no point moves more than linear_step between samples.

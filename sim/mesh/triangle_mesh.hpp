@@ -63,7 +63,8 @@ inline bool pieces_are_exact(const TriangleMesh& mesh) { return mesh.pieces.size
 // Each piece's vertices on its convex hull (all of them for a flat or degenerate piece).
 std::vector<std::vector<std::uint32_t>> hull_corners(const TriangleMesh& mesh);
 constexpr std::size_t kCoarseCorners = 256;
-// 0.01 mm: a thirtieth of the contact tolerance, and on the safe side (the hull only grows).
+// 0.01 mm: a thirtieth of the contact tolerance, and on the safe side (the hull only grows,
+// and a distance to it is taken to its grown surface).
 constexpr double kSimplifiedHullGrowth = 1e-5;
 // Fills coarse_corners and coarse_margin of a one-piece mesh whose hull_corners are set.
 void make_coarse_hull(TriangleMesh& mesh);

@@ -167,6 +167,47 @@ TEST_CASE("a concave ring set into a concave ring is caught by volume, however f
   }
 }
 
+TEST_CASE("a concave ring resting on one concave part and set into another is caught in the second",
+          "[collision][exact]") {
+  // The ring's triangles that rest on the part below are asked by volume against it; that
+  // must not keep them from being asked against the wide ring that they also go 0.4 mm into,
+  // whose own corners and middles all lie outside the ring (and triangle against triangle
+  // lets two thin crossing triangles go).
+  const auto joined = [](sim::TriangleMesh a, const sim::TriangleMesh& b) {  // one piece
+    const auto offset = static_cast<std::uint32_t>(a.vertices.size());
+    for (const auto& v : b.vertices) {
+      a.pieces.back().push_back(static_cast<std::uint32_t>(a.vertices.size()));
+      a.vertices.push_back(v);
+      a.bounds.extend(v);
+    }
+    for (const auto& t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    return a;
+  };
+  // A ring with a pin standing in the moving ring's bore, 6 mm clear of it: its hull is hit.
+  auto below = std::make_shared<sim::TriangleMesh>(
+      joined(test::tube_mesh(1250, 0.020, 0.010, 0.005), test::tube_mesh(64, 0.004, 0, 0.008)));
+  auto wide = std::make_shared<sim::TriangleMesh>(test::tube_mesh(1250, 0.060, 0.005, 0.005));
+  sim::CollisionWorld world;
+  const auto add_below = [&] { world.add_static_mesh("ring below", below, sim::Pose::Identity()); };
+  const auto add_wide = [&] { world.add_static_mesh("wide ring", wide, at(0, 0.0004, 0)); };  // its top 0.4 mm higher
+  SECTION("the ring below asked first") {
+    add_below();
+    add_wide();
+  }
+  SECTION("the wide ring asked first") {
+    add_wide();
+    add_below();
+  }
+  sim::MovingBody ring;
+  ring.add_mesh("ring", test::tube_mesh(1250, 0.02001, 0.010, 0.005), sim::Pose::Identity(), world.options().shape_margin);
+  const auto hit = world.penetration(ring, at(0, 0.005, 0));  // resting on the ring below
+  REQUIRE(hit);
+  CHECK(hit->body_name == "wide ring");
+  CHECK(hit->depth > world.options().contact_tolerance);
+  CHECK(hit->depth <= 0.0004 + 1e-4);
+  CHECK_FALSE(world.penetration(ring, at(0, 0.0054, 0)));  // on the wide ring, clear of the other
+}
+
 TEST_CASE("a concave ring over a concave ring is nearest where it comes nearest, held flat or tilted",
           "[collision][exact]") {
   // Pairs of triangles whose boxes lie as far apart as the nearest pair so far are not asked:
@@ -226,6 +267,25 @@ TEST_CASE("a convex pin of many corners is checked by a hull of few, at most 0.0
       CHECK(exact == Approx(0.0005).margin(1e-4));  // 0.4 mm and the two shapes' margins
       CHECK(simplified >= exact);  // the simplified hull only grows
       CHECK(simplified <= exact + sim::kSimplifiedHullGrowth);
+    }
+    // Its room to a wall 0.2 mm beside it, turned so that the wall faces the simplified hull's
+    // corners or the edges between them: never more than the exact pin's, at most the growth less.
+    sim::CollisionWorld beside;
+    beside.add_static_box("wall", {0.005, 0.01, 0.02}, at(radius + 0.0002 + 0.005, 0, 0));
+    for (int step = 0; step < 8; ++step) {
+      sim::Pose turned = sim::Pose::Identity();
+      turned.linear() = Eigen::AngleAxisd(step * 0.4 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      const auto room_of = [&](const sim::TriangleMesh& mesh) {
+        sim::MovingBody body;
+        body.add_mesh("pin", mesh, sim::Pose::Identity(), beside.options().shape_margin);
+        const auto near = beside.nearest(body, turned, 0.001);
+        return near ? near->distance : 1.0;
+      };
+      INFO("turned by " << step * 0.4 << " degrees");
+      const double room = room_of(pin), exact_room = room_of(exact_pin);
+      CHECK(exact_room == Approx(0.0002).margin(1e-6));
+      CHECK(room <= exact_room + 1e-9);
+      CHECK(room >= exact_room - sim::kSimplifiedHullGrowth);
     }
     // The pin standing, the ring coming down onto it.
     sim::CollisionWorld standing;
