@@ -82,6 +82,8 @@ class MovingBody {
   double radius_ = 0;
 };
 
+// Static bodies and the checks of moving bodies against them. One thread at a time: the const
+// checks fill caches (volumes, exact shapes) in the world and in the moving body.
 class CollisionWorld {
  public:
   explicit CollisionWorld(CollisionOptions options = {});
