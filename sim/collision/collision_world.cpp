@@ -9,7 +9,6 @@
 #include <map>
 #include <numeric>
 #include <set>
-#include <tuple>
 
 #include <btBulletCollisionCommon.h>
 #include <BulletCollision/CollisionShapes/btTriangleShape.h>
@@ -668,11 +667,12 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   // the corners and middles of each such triangle lie in the other's volume (a corner of a
   // finely tessellated ring's wall 4 mm into the ring below, whose triangles GJK/EPA let go
   // 0.1 mm apart). Closed meshes only: an open one has no inside. Each triangle once per member
-  // and body (one that rests on a part may go into the next): its corners and its middle. The
-  // first point deeper than the tolerance ends the search: its depth is then a least one (asking
-  // them all took 23 s for a ring of 50 000 triangles 0.4 mm into another).
-  std::set<std::tuple<std::size_t, int, BodyId>> moving_done;  // (member, its triangle, the body asked)
-  std::set<std::tuple<BodyId, int, std::size_t>> static_done;  // (body, its triangle, the member asked)
+  // and static body (one that rests on a part may go into the next; the static body's are kept
+  // while it is asked): its corners and its middle. The first point deeper than the tolerance
+  // ends the search: its depth is then a least one (asking them all took 23 s for a ring of
+  // 50 000 triangles 0.4 mm into another).
+  std::set<std::pair<std::size_t, int>> moving_done;  // (member, its triangle)
+  std::set<std::pair<int, std::size_t>> static_done;  // (the static body's triangle, the member)
   const auto inside_other = [&](const std::vector<DeepestContact::Crossing>& crossings) -> std::optional<Contact> {
     std::optional<Contact> hit;
     const auto consider = [&](double depth, const Eigen::Vector3d& where, BodyId b, const std::string& member) {
@@ -703,7 +703,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
         const Eigen::Vector3d &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
         return std::array<Eigen::Vector3d, 4>{a, b, c, (a + b + c) / 3};
       };
-      if (moving_done.insert({child, triangle, crossing.body}).second && static_cast<std::size_t>(triangle) < moving_mesh.triangles.size()) {
+      if (moving_done.insert({child, triangle}).second && static_cast<std::size_t>(triangle) < moving_mesh.triangles.size()) {
         const Solid& into = impl_->solid_of_body(fixed);
         const Pose to_fixed = fixed.pose.inverse() * member_pose;
         for (const auto& p : points_of(moving_mesh, static_cast<std::size_t>(triangle))) {
@@ -711,7 +711,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
           if (hit) return hit;
         }
       }
-      if (static_done.insert({crossing.body, crossing.triangle, child}).second && crossing.triangle >= 0 &&
+      if (static_done.insert({crossing.triangle, child}).second && crossing.triangle >= 0 &&
           static_cast<std::size_t>(crossing.triangle) < fixed_mesh.triangles.size()) {
         const Solid& into = moving.solid(child);
         const Pose to_member = member_pose.inverse() * fixed.pose;
@@ -738,6 +738,8 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   callback.self = &probe;
   const btDbvt* tree = exact.compound.getDynamicAabbTree();
   for (BodyId b : coarse.coarse_hits) {
+    moving_done.clear();
+    static_done.clear();
     btCollisionObject& fixed = *impl_->bodies.at(b).exact;
     btVector3 min, max;
     fixed.getCollisionShape()->getAabb(at.inverse() * fixed.getWorldTransform(), min, max);
