@@ -39,6 +39,11 @@ void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostre
                    step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)"});
   }
   table.print(out);
+  if (plan.verification.run) {
+    const auto& v = plan.verification;
+    out << "\nVerified: " << (v.passed ? "every step replayed clear" : "NOT every step replayed clear") << " ("
+        << v.sweeps << " straight moves and " << v.poses << " poses checked, " << fixed(v.seconds * 1000, 1) << " ms)\n";
+  }
   out << "\nFindings:\n";
   if (plan.findings.empty()) out << "  none\n";
   for (const auto& f : plan.findings) out << "  [" << f.kind << "] " << f.message << '\n';

@@ -300,6 +300,26 @@ btScalar begins_at(const btConvexShape* piece, const btTransform& at, const btVe
   return box_begins_at(lo, hi, axis);
 }
 
+// Whether two triangles of two meshes, where they stand, cross: they meet, and not only in
+// one plane (two faces resting on each other meet in their plane without crossing).
+bool crossing_triangles(const TriangleMesh& a, std::size_t ta, const Pose& pa, const TriangleMesh& b, std::size_t tb,
+                        const Pose& pb) {
+  if (ta >= a.triangles.size() || tb >= b.triangles.size()) return false;
+  const auto corners = [](const TriangleMesh& m, std::size_t t, const Pose& p) {
+    return std::array<Eigen::Vector3d, 3>{p * m.vertices[m.triangles[t][0]], p * m.vertices[m.triangles[t][1]],
+                                          p * m.vertices[m.triangles[t][2]]};
+  };
+  const auto x = corners(a, ta, pa), y = corners(b, tb, pb);
+  const Eigen::Vector3d nx = (x[1] - x[0]).cross(x[2] - x[0]), ny = (y[1] - y[0]).cross(y[2] - y[0]);
+  if (nx.squaredNorm() == 0 || ny.squaredNorm() == 0) return false;
+  constexpr double kInPlane = 1e-9;  // m
+  const Eigen::Vector3d ux = nx.normalized();
+  if (ux.cross(ny.normalized()).norm() < 1e-9 && std::abs(ux.dot(y[0] - x[0])) < kInPlane) return false;
+  const auto point = [](const Eigen::Vector3d& v) { return SolidPoint(v.x(), v.y(), v.z()); };
+  return CGAL::do_intersect(SolidKernel::Triangle_3(point(x[0]), point(x[1]), point(x[2])),
+                            SolidKernel::Triangle_3(point(y[0]), point(y[1]), point(y[2])));
+}
+
 // The children of a compound whose boxes overlap a box in its frame.
 struct ChildrenIn : btDbvt::ICollide {
   std::vector<int> children;
@@ -664,26 +684,31 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   if (!coarse.deepest && coarse.coarse_hits.empty()) return std::nullopt;
 
   // Where a concave moving member's triangles touch or cross a concave static body's: how deep
-  // the corners and middles of each such triangle lie in the other's volume (a corner of a
-  // finely tessellated ring's wall 4 mm into the ring below, whose triangles GJK/EPA let go
-  // 0.1 mm apart). Closed meshes only: an open one has no inside. Each triangle once per member
-  // and static body (one that rests on a part may go into the next; the static body's are kept
-  // while it is asked): its corners and its middle. The first point deeper than the tolerance
-  // ends the search: its depth is then a least one (asking them all took 23 s for a ring of
-  // 50 000 triangles 0.4 mm into another).
+  // each such triangle lies in the other's volume, searched over the whole triangle
+  // (sim::deepest_inside: a finely tessellated ring's wall 4 mm into the ring below, whose
+  // triangles GJK/EPA let go 0.1 mm apart; a channel's long face crossing another channel's
+  // walls between its corners and its middle). Closed meshes only: an open one has no inside.
+  // Each triangle once per member and static body (one that rests on a part may go into the
+  // next; the static body's are kept while it is asked). The first point deeper than the
+  // tolerance ends the search: its depth is then a least one (asking them all took 23 s for
+  // a ring of 50 000 triangles 0.4 mm into another).
   std::set<std::pair<std::size_t, int>> moving_done;  // (member, its triangle)
   std::set<std::pair<int, std::size_t>> static_done;  // (the static body's triangle, the member)
+  const double resolution = tolerance / 2;
   const auto inside_other = [&](const std::vector<DeepestContact::Crossing>& crossings) -> std::optional<Contact> {
-    std::optional<Contact> hit;
-    const auto consider = [&](double depth, const Eigen::Vector3d& where, BodyId b, const std::string& member) {
-      if (depth <= tolerance) return;
+    const auto deep_in = [&](const Solid& into, const TriangleMesh& mesh, std::size_t t, const Pose& to_into,
+                             const Pose& to_world, BodyId b, const std::string& member) -> std::optional<Contact> {
+      const auto& tri = mesh.triangles[t];
+      const auto deep = deepest_inside(into, {to_into * mesh.vertices[tri[0]], to_into * mesh.vertices[tri[1]],
+                                              to_into * mesh.vertices[tri[2]]}, tolerance, resolution);
+      if (!deep) return std::nullopt;
       Contact c;
       c.body = b;
       c.body_name = impl_->bodies.at(b).name;
       c.member = member;
-      c.depth = depth;
-      c.point = where;
-      hit = c;
+      c.depth = deep->depth;
+      c.point = to_world * (to_into.inverse() * deep->point);
+      return c;
     };
     for (const auto& crossing : crossings) {
       const auto body_it = impl_->bodies.find(crossing.body);
@@ -698,30 +723,28 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
       const TriangleMesh& fixed_mesh = *impl_->meshes.at(fixed.mesh).mesh;
       const Pose member_pose = pose * moving.offset_of_child[child];
       const std::string& member = moving.coarse.member_of_child[child];
-      const auto points_of = [](const TriangleMesh& mesh, std::size_t t) {
-        const auto& tri = mesh.triangles[t];
-        const Eigen::Vector3d &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
-        return std::array<Eigen::Vector3d, 4>{a, b, c, (a + b + c) / 3};
-      };
+      // Only triangles that cross: one that goes deep into the other's volume crosses its
+      // surface somewhere, and a pair that only touches (a face resting on a face, a tenon
+      // 0.04 mm clear in its mortise) would be searched over its whole area for nothing.
+      if (!crossing_triangles(moving_mesh, static_cast<std::size_t>(triangle), member_pose, fixed_mesh,
+                              static_cast<std::size_t>(crossing.triangle), fixed.pose)) {
+        continue;
+      }
       if (moving_done.insert({child, triangle}).second && static_cast<std::size_t>(triangle) < moving_mesh.triangles.size()) {
-        const Solid& into = impl_->solid_of_body(fixed);
-        const Pose to_fixed = fixed.pose.inverse() * member_pose;
-        for (const auto& p : points_of(moving_mesh, static_cast<std::size_t>(triangle))) {
-          consider(into.depth(to_fixed * p, tolerance), member_pose * p, crossing.body, member);
-          if (hit) return hit;
+        if (auto hit = deep_in(impl_->solid_of_body(fixed), moving_mesh, static_cast<std::size_t>(triangle),
+                               fixed.pose.inverse() * member_pose, member_pose, crossing.body, member)) {
+          return hit;
         }
       }
       if (static_done.insert({crossing.triangle, child}).second && crossing.triangle >= 0 &&
           static_cast<std::size_t>(crossing.triangle) < fixed_mesh.triangles.size()) {
-        const Solid& into = moving.solid(child);
-        const Pose to_member = member_pose.inverse() * fixed.pose;
-        for (const auto& p : points_of(fixed_mesh, static_cast<std::size_t>(crossing.triangle))) {
-          consider(into.depth(to_member * p, tolerance), fixed.pose * p, crossing.body, member);
-          if (hit) return hit;
+        if (auto hit = deep_in(moving.solid(child), fixed_mesh, static_cast<std::size_t>(crossing.triangle),
+                               member_pose.inverse() * fixed.pose, fixed.pose, crossing.body, member)) {
+          return hit;
         }
       }
     }
-    return hit;
+    return std::nullopt;
   };
 
   // The exact body: against boxes and convex bodies all at once; then against each concave

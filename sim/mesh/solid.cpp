@@ -46,17 +46,59 @@ double Solid::depth(const Eigen::Vector3d& p, double tolerance) const {
   return distance > tolerance && contains(q, nearest, face) ? distance : 0;
 }
 
-std::unique_ptr<Solid> solid_of(const TriangleMesh& source) {
+std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eigen::Vector3d, 3>& triangle,
+                                        double tolerance, double resolution, bool deepest) {
+  if (!solid.inside) return std::nullopt;
+  std::optional<DeepPoint> found;
+  std::vector<std::array<Eigen::Vector3d, 3>> pieces{triangle};
+  while (!pieces.empty()) {
+    const std::array<Eigen::Vector3d, 3> t = pieces.back();
+    pieces.pop_back();
+    const Eigen::Vector3d middle = (t[0] + t[1] + t[2]) / 3;
+    const double radius = std::max({(t[0] - middle).norm(), (t[1] - middle).norm(), (t[2] - middle).norm()});
+    const SolidPoint q = solid_point(middle);
+    const auto [nearest, face] = solid.surface->closest_point_and_primitive(q);
+    const double distance = std::sqrt(CGAL::squared_distance(q, nearest));
+    // Only a point deeper than this matters; the deepest is wanted to within the resolution.
+    const double floor = deepest && found ? found->depth + resolution : tolerance;
+    // No point of the piece lies deeper than its corners' distance from one face of the surface
+    // (the distance to a triangle is convex, so it is largest at a corner), nor deeper than the
+    // middle's depth (negative outside) plus the radius.
+    const auto h = solid.mesh.halfedge(face);
+    const SolidKernel::Triangle_3 nearest_face(solid.mesh.point(solid.mesh.source(h)), solid.mesh.point(solid.mesh.target(h)),
+                                               solid.mesh.point(solid.mesh.target(solid.mesh.next(h))));
+    double bound = 0;
+    for (const auto& corner : t) bound = std::max(bound, CGAL::squared_distance(solid_point(corner), nearest_face));
+    bound = std::sqrt(bound);
+    if (bound <= floor) continue;
+    const bool in = solid.contains(q, nearest, face);
+    if (std::min(bound, (in ? distance : -distance) + radius) <= floor) continue;
+    if (in && distance > floor) {
+      found = DeepPoint{distance, middle};
+      if (!deepest) return found;
+    }
+    if (radius <= resolution) continue;
+    const Eigen::Vector3d ab = (t[0] + t[1]) / 2, bc = (t[1] + t[2]) / 2, ca = (t[2] + t[0]) / 2;
+    pieces.push_back({t[0], ab, ca});
+    pieces.push_back({ab, t[1], bc});
+    pieces.push_back({ca, bc, t[2]});
+    pieces.push_back({ab, bc, ca});
+  }
+  return found;
+}
+
+std::unique_ptr<Solid> solid_of(const TriangleMesh& source, bool with_samples) {
   auto s = std::make_unique<Solid>();
   std::vector<Solid::Mesh::Vertex_index> vertices;
   vertices.reserve(source.vertices.size());
   for (const auto& v : source.vertices) {
     vertices.push_back(s->mesh.add_vertex(solid_point(v)));
-    s->samples.push_back(v);
+    if (with_samples) s->samples.push_back(v);
   }
   bool manifold = true;
   for (const auto& t : source.triangles) {
     if (s->mesh.add_face(vertices[t[0]], vertices[t[1]], vertices[t[2]]) == Solid::Mesh::null_face()) manifold = false;
+    if (!with_samples) continue;
     const Eigen::Vector3d &a = source.vertices[t[0]], &b = source.vertices[t[1]], &c = source.vertices[t[2]];
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
     const int n = std::clamp(static_cast<int>(std::ceil(longest / kSampleSpacing)), 1, kMaxDivisions);

@@ -6,7 +6,9 @@
 // Used by the finished product's interference check (twin/planning/interference.*) and by
 // the collision world's check of a concave part against a concave part.
 
+#include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
@@ -32,7 +34,8 @@ struct Solid {
   std::unique_ptr<Tree> surface;
   std::unique_ptr<SideOf> inside;  // null: the mesh is not closed, it has no inside
   double orientation = 1;          // -1: its faces are wound inwards
-  // Its vertices, then points over each triangle at most 2 mm apart (coarser on large faces).
+  // Its vertices, then points over each triangle at most 2 mm apart (coarser on large faces);
+  // only where asked for (solid_of).
   std::vector<Eigen::Vector3d> samples;
 
   // Whether a point lies inside (false for a solid that has no inside); the second form for
@@ -44,8 +47,27 @@ struct Solid {
   double depth(const Eigen::Vector3d& p, double tolerance) const;
 };
 
+// A point of a triangle that lies inside a solid, and how deep.
+struct DeepPoint {
+  double depth = 0;  // m: its distance from the solid's surface
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+};
+
+// How deep the triangle (corners in the solid's frame) goes into the solid, searched over the
+// whole triangle, not at chosen points: it is cut into smaller triangles, and one is given up
+// where no point of it can lie deeper than `tolerance` (its corners' distance from the face
+// nearest its middle bounds every inner point's depth: the distance to a face is convex) or
+// where it lies wholly outside (its middle outside, farther from the surface than any of its
+// points is from the middle).
+// Returns a point deeper than `tolerance` (with `deepest`, the deepest to within
+// `resolution`; else the first), or nothing. Down to pieces of circumradius `resolution`: a point up to that much
+// deeper than `tolerance` in a piece of that size may go unseen (never one deeper than
+// tolerance + resolution). A solid without an inside holds nothing.
+std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eigen::Vector3d, 3>& triangle,
+                                        double tolerance, double resolution, bool deepest = false);
+
 inline SolidPoint solid_point(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-std::unique_ptr<Solid> solid_of(const TriangleMesh& mesh);
+std::unique_ptr<Solid> solid_of(const TriangleMesh& mesh, bool with_samples = false);
 
 }  // namespace sim

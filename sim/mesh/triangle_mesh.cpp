@@ -4,7 +4,6 @@
 #include "sim/mesh/triangle_bvh.hpp"
 
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
-#include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
 #include <LinearMath/btConvexHullComputer.h>
 
 #include <algorithm>
@@ -132,7 +131,84 @@ void repair(TriangleMesh& mesh) {
   orient(mesh, edges);
 }
 
+// The closest point of the triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double denominator = 1 / (va + vb + vc);
+  return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
 }  // namespace
+
+double farthest_outside(const TriangleMesh& mesh, const std::vector<std::uint32_t>& hull_of,
+                        const std::vector<std::uint32_t>& points) {
+  std::vector<Eigen::Vector3d> taken;
+  for (auto index : hull_of) taken.push_back(mesh.vertices[index]);
+  btConvexHullComputer hull;
+  hull.compute(taken.front().data(), sizeof(Eigen::Vector3d), static_cast<int>(taken.size()), 0, 0);
+  // Its faces as triangle fans of the taken points (exact, in doubles), with outward normals.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : taken) centre += p;
+  centre /= static_cast<double>(taken.size());
+  struct Face {
+    std::vector<Eigen::Vector3d> corners;
+    Eigen::Vector3d normal;
+    double offset;
+  };
+  std::vector<Face> faces;
+  for (int f = 0; f < hull.faces.size(); ++f) {
+    Face face;
+    const btConvexHullComputer::Edge* first = &hull.edges[hull.faces[f]];
+    const btConvexHullComputer::Edge* e = first;
+    do {
+      face.corners.push_back(taken[static_cast<std::size_t>(hull.original_vertex_index[e->getSourceVertex()])]);
+      e = e->getNextEdgeOfFace();
+    } while (e != first && face.corners.size() <= taken.size());
+    if (face.corners.size() < 3) continue;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();  // Newell's normal of the polygon
+    for (std::size_t i = 0; i < face.corners.size(); ++i) n += face.corners[i].cross(face.corners[(i + 1) % face.corners.size()]);
+    if (n.norm() == 0) continue;
+    n.normalize();
+    if (n.dot(face.corners[0] - centre) < 0) n = -n;
+    face.normal = n;
+    face.offset = n.dot(face.corners[0]);
+    faces.push_back(std::move(face));
+  }
+  double farthest = 0;
+  constexpr double kOnPlane = 1e-10;  // m: rounding of a corner that lies on a face
+  for (auto index : points) {
+    const Eigen::Vector3d& p = mesh.vertices[index];
+    // Outside a convex hull, the nearest point lies on a face the point sees; a corner of the
+    // hull lies on its own faces (to rounding), and is 0 from them.
+    double nearest = std::numeric_limits<double>::infinity();
+    bool sees_one = false;
+    for (const Face& face : faces) {
+      const double above = face.normal.dot(p) - face.offset;
+      if (above < -kOnPlane) continue;
+      sees_one = sees_one || above > kOnPlane;
+      for (std::size_t i = 1; i + 1 < face.corners.size(); ++i) {
+        nearest = std::min(nearest, (p - closest_on_triangle(p, face.corners[0], face.corners[i], face.corners[i + 1])).norm());
+      }
+    }
+    if (sees_one) farthest = std::max(farthest, nearest);
+  }
+  return farthest;
+}
 
 std::string TriangleMesh::Repairs::describe() const {
   std::vector<std::string> said;
@@ -199,26 +275,15 @@ void make_coarse_hull(TriangleMesh& mesh) {
     }
     next = farthest;
   }
-  // How far the corners left out lie outside the hull of those taken (GJK, in millimetres,
-  // where Bullet's tolerances are meant for).
-  btConvexHullShape core;
-  for (auto index : mesh.coarse_corners) {
-    const Eigen::Vector3d p = mesh.vertices[index] * 1000;
-    core.addPoint(btVector3(p.x(), p.y(), p.z()), false);
-  }
-  core.recalcLocalAabb();
-  core.setMargin(0);
-  double outside = 0;
-  for (auto index : corners) {
-    const Eigen::Vector3d p = mesh.vertices[index] * 1000;
-    btGjkEpaSolver2::sResults result;
-    const double distance =
-        btGjkEpaSolver2::SignedDistance(btVector3(p.x(), p.y(), p.z()), 0, &core, btTransform::getIdentity(), result);
-    outside = std::max(outside, distance);
-  }
-  // A little over, for GJK's own tolerance.
-  mesh.coarse_margin = outside / 1000 * 1.01 + 1e-6;
-  if (mesh.convex && mesh.coarse_margin > kSimplifiedHullGrowth) {  // a sphere: too round for 256
+  // How far the corners left out lie outside the hull of those taken. (Bullet's GJK, which
+  // was asked this before, answers some corners of a CAD export's rounded edges with
+  // infinity: the hull then grew by 3e35 m and every collision of the part went unseen.)
+  const double outside = farthest_outside(mesh, mesh.coarse_corners, corners);
+  // A little over, for the checks' own rounding.
+  mesh.coarse_margin = outside * 1.01 + 1e-6;
+  // A convex mesh too round for 256 corners (a sphere), or a hull that would not be near the
+  // mesh (no such mesh is known; the full hull is then the coarse one): none.
+  if ((mesh.convex && mesh.coarse_margin > kSimplifiedHullGrowth) || !(mesh.coarse_margin < 0.01 * mesh.bounds.sizes().norm())) {
     mesh.coarse_corners.clear();
     mesh.coarse_margin = 0;
   }

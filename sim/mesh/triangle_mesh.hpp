@@ -68,6 +68,10 @@ constexpr std::size_t kCoarseCorners = 256;
 constexpr double kSimplifiedHullGrowth = 1e-5;
 // Fills coarse_corners and coarse_margin of a one-piece mesh whose hull_corners are set.
 void make_coarse_hull(TriangleMesh& mesh);
+// How far the farthest of `points` lies outside the convex hull of `hull_of` (vertex indices
+// of the mesh), m; 0 where all lie inside it.
+double farthest_outside(const TriangleMesh& mesh, const std::vector<std::uint32_t>& hull_of,
+                        const std::vector<std::uint32_t>& points);
 // Whether the collision check takes a convex mesh's hull as its coarse one (make_coarse_hull).
 inline bool hull_simplified(const TriangleMesh& mesh) { return mesh.convex && !mesh.coarse_corners.empty(); }
 // What loading repaired or found, and what the check simplifies, for a finding ("" for none).

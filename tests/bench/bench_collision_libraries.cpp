@@ -255,7 +255,7 @@ openvdb::FloatGrid::Ptr level_set(const sim::TriangleMesh& m, double voxel) {
 
 struct VdbCase {
   VdbCase(const Case& c, double voxel) : grid(level_set(*c.base, voxel)) {
-    const auto moving = sim::solid_of(c.moving);
+    const auto moving = sim::solid_of(c.moving, true);
     for (const auto& p : moving->samples) samples.push_back(c.pose * p * 1000);
   }
   double deepest() const {

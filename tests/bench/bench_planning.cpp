@@ -29,7 +29,8 @@ std::filesystem::path wall_dir(int columns, int rows) {
   return dir / "wall.aml";
 }
 
-// `sequence`: "paper" or "search"; "search, no margins": without insertion margins.
+// `sequence`: "paper" or "search"; "search, no margins": without insertion margins;
+// "search, unverified": without the plan's independent replay (plan_verifier.hpp).
 void plan_file(benchmark::State& state, const std::filesystem::path& file, std::string sequence) {
   sim::MeshCache cache;
   const twin::LoadedProduct loaded = twin::load_product(file, cache);
@@ -37,6 +38,10 @@ void plan_file(benchmark::State& state, const std::filesystem::path& file, std::
   if (sequence == "search, no margins") {
     sequence = "search";
     options.margin_reach = 0;
+  }
+  if (sequence == "search, unverified") {
+    sequence = "search";
+    options.verify = false;
   }
   std::size_t trajectories = 0;
   for (auto _ : state) {
@@ -184,8 +189,10 @@ void BM_PegSweep(benchmark::State& state) {
 BENCHMARK_CAPTURE(BM_Cranfield, paper, std::string("paper"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cranfield, search, std::string("search"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Cranfield, search_no_margins, std::string("search, no margins"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Cranfield, search_unverified, std::string("search, unverified"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LegoTower, paper, std::string("paper"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LegoTower, search, std::string("search"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LegoTower, search_unverified, std::string("search, unverified"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, paper, std::string("paper"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, search, std::string("search"))->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Wall, search_no_margins, std::string("search, no margins"))->Arg(1000)->Unit(benchmark::kMillisecond);

@@ -451,3 +451,26 @@ TEST_CASE("a concave mesh's triangle tree is made at loading, kept by the disk c
   CHECK(hits > 50);
   CHECK(misses > 50);
 }
+
+TEST_CASE("a concave part crossing a concave part between its triangles' corners is caught", "[collision][concave]") {
+  // Two U channels of one piece each, 200 mm long, their long faces two triangles from end to
+  // end, crossed at right angles: the upper one's base 1 mm down into the lower one's walls.
+  // No corner and no middle of any triangle lies in the other channel (the crossing is in the
+  // middle, the corners at the ends, the middles a third of the way), so points of the
+  // triangles chosen in advance would not tell; the volume stage searches whole triangles
+  // (sim::deepest_inside).
+  sim::CollisionWorld world;
+  const auto lower = std::make_shared<sim::TriangleMesh>(test::u_channel(0.2, 0.02, 0.02, 0.004));
+  world.add_static_mesh("lower", lower, sim::Pose::Identity());
+  sim::MovingBody upper;
+  upper.add_mesh("part", test::u_channel(0.2, 0.02, 0.02, 0.004), sim::Pose::Identity(), world.options().shape_margin);
+  sim::Pose crossed = at(0, 0.019, 0);  // its base's underside 1 mm below the walls' tops
+  crossed.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const auto hit = world.penetration(upper, crossed);
+  REQUIRE(hit);
+  CHECK(hit->body_name == "lower");
+  CHECK(hit->depth > world.options().contact_tolerance);
+  // Resting on the walls: clear.
+  crossed.translation().y() = 0.020;
+  CHECK_FALSE(world.penetration(upper, crossed));
+}

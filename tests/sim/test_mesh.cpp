@@ -211,3 +211,35 @@ TEST_CASE("COLLADA: the file's own unit is applied, its up axis is not (coordina
     CHECK(block->convex);
   }
 }
+
+TEST_CASE("a coarse hull holds every corner of the mesh: a real CAD post with rounded edges", "[mesh]") {
+  // The post of ASAP's beam frame (tests/data/real), 4 904 triangles, 483 hull corners. Its
+  // coarse hull is 256 of them grown to hold the rest. Bullet's GJK, which measured that,
+  // answered eight of the corners with infinity: the hull grew by 3e35 m, and every
+  // collision of the post, and of a beam coming down over it, went unseen.
+  const auto file = std::filesystem::path(REAL_DATA_DIR) / "asap-beam-frame/meshes/2.obj";
+  const auto mesh = sim::load_mesh(file, 0.01);
+  REQUIRE(mesh->hull_corners.size() == 1);
+  REQUIRE(mesh->coarse_corners.size() == sim::kCoarseCorners);
+  CHECK(mesh->coarse_margin < 1e-4);
+  CHECK(sim::farthest_outside(*mesh, mesh->coarse_corners, mesh->hull_corners[0]) <= mesh->coarse_margin);
+  CHECK(sim::farthest_outside(*mesh, mesh->hull_corners[0], mesh->hull_corners[0]) == 0);
+}
+
+TEST_CASE("how far points lie outside a hull: beyond a face, an edge, a corner; inside and on it, 0", "[mesh]") {
+  sim::TriangleMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+  const std::vector<std::uint32_t> cube{0, 1, 2, 3, 4, 5, 6, 7};
+  const auto outside = [&](const Eigen::Vector3d& p) {
+    m.vertices.push_back(p);
+    const double d = sim::farthest_outside(m, cube, {static_cast<std::uint32_t>(m.vertices.size() - 1)});
+    m.vertices.pop_back();
+    return d;
+  };
+  CHECK(outside({3, 0, 0}) == Approx(2));
+  CHECK(outside({2, 2, 0}) == Approx(std::sqrt(2.0)));
+  CHECK(outside({2, 2, 2}) == Approx(std::sqrt(3.0)));
+  CHECK(outside({0.5, 0, 0}) == 0);
+  CHECK(outside({1, 0.3, -0.2}) == 0);
+  CHECK(sim::farthest_outside(m, cube, cube) == 0);
+}

@@ -73,4 +73,36 @@ inline sim::TriangleMesh tube_mesh(int segments, double outer, double inner, dou
   return m;
 }
 
+// A U channel of one piece along x, as a CAD export writes it: its long faces two triangles
+// each from end to end, so no corner and no middle of them lies near the channel's own
+// middle. Open upwards: a base `thickness` thick, walls `thickness` thick and `height` tall,
+// `width` across (z), `length` long (m), lying on y = 0.
+inline sim::TriangleMesh u_channel(double length, double width, double height, double thickness) {
+  sim::TriangleMesh m;
+  m.pieces.emplace_back();
+  const double w = width / 2, t = thickness;
+  // The profile in (z, y) and its triangles.
+  const std::vector<std::array<double, 2>> profile{{-w, 0}, {w, 0}, {w, height}, {w - t, height},
+                                                   {w - t, t}, {-w + t, t}, {-w + t, height}, {-w, height}};
+  const std::vector<std::array<std::uint32_t, 3>> cap{{0, 1, 4}, {0, 4, 5}, {1, 2, 3}, {1, 3, 4}, {0, 5, 6}, {0, 6, 7}};
+  const auto n = static_cast<std::uint32_t>(profile.size());
+  for (const double x : {-length / 2, length / 2}) {
+    for (const auto& [z, y] : profile) m.vertices.emplace_back(x, y, z);
+  }
+  for (const auto& c : cap) {
+    m.triangles.push_back({c[0], c[1], c[2]});              // at -x, facing -x
+    m.triangles.push_back({c[0] + n, c[2] + n, c[1] + n});  // at +x, facing +x
+  }
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const std::uint32_t a = k, b = (k + 1) % n;
+    m.triangles.push_back({a, b + n, b});
+    m.triangles.push_back({a, a + n, b + n});
+  }
+  for (std::uint32_t i = 0; i < m.vertices.size(); ++i) {
+    m.pieces.back().push_back(i);
+    m.bounds.extend(m.vertices[i]);
+  }
+  return m;
+}
+
 }  // namespace test

@@ -1,9 +1,11 @@
 #include "twin/planning/assembly_planner.hpp"
 
 #include "twin/planning/interference.hpp"
+#include "twin/planning/plan_verifier.hpp"
 #include "twin/planning/subassembly_planner.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -368,13 +370,42 @@ double least_margin(const std::vector<PlanStep>& steps, double reach) {
   return least;
 }
 
+namespace {
+
+// The plan replayed on its own (plan_verifier.hpp): a step that fails it makes the plan
+// incomplete, with a finding that says what went how deep into what.
+void verify(const LoadedProduct& product, Plan& plan, const PlannerOptions& options) {
+  VerifyOptions check;
+  check.contact_tolerance = options.collision.contact_tolerance;
+  check.resolution = options.verify_resolution;
+  check.gripper = options.gripper;
+  const auto start = std::chrono::steady_clock::now();
+  const Verification v = verify_plan(product, plan, check);
+  plan.verification.run = true;
+  plan.verification.passed = v.violations.empty();
+  plan.verification.poses = v.poses;
+  plan.verification.sweeps = v.sweeps;
+  plan.verification.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const Violation& violation : v.violations) {
+    plan.findings.push_back({"verification", describe(product.product, violation) + ": the step cannot be built as planned",
+                             {product.product.parts()[plan.steps[violation.step - 1].part].name, violation.with}});
+  }
+  if (!v.violations.empty()) plan.complete = false;
+}
+
+}  // namespace
+
 Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
                    const PlannerOptions& options) {
+  Plan plan;
   if (!subassemblies_of(product.product).empty()) {
     if (!options.given.empty()) throw std::logic_error("planning on from given steps of a product with subassemblies");
-    return plan_with_subassemblies(product, sequence, path, options);
+    plan = plan_with_subassemblies(product, sequence, path, options);
+  } else {
+    plan = Search(product, sequence, path, options).run();
   }
-  return Search(product, sequence, path, options).run();
+  if (options.verify) verify(product, plan, options);
+  return plan;
 }
 
 }  // namespace twin

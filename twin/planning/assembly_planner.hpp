@@ -43,7 +43,17 @@ struct Finding {
   std::vector<std::string> parts;
 };
 
+// The independent replay of the plan (plan_verifier.hpp).
+struct PlanVerification {
+  bool run = false;     // replayed (PlannerOptions::verify)
+  bool passed = false;  // every step clear
+  std::size_t poses = 0, sweeps = 0;  // checked
+  double seconds = 0;
+};
+
 struct Plan {
+  // Every part in, and (where verification runs) every step replayed clear: the promise the
+  // cell is given.
   bool complete = false;
   std::vector<PlanStep> steps;
   std::vector<Finding> findings;
@@ -53,6 +63,7 @@ struct Plan {
   std::size_t trajectories_simulated = 0;
   std::vector<SubassemblyPlan> subassemblies;  // each one's steps come before the step inserting it
   double margin_threshold = 0, margin_reach = 0;  // m, as planned with (PlannerOptions)
+  PlanVerification verification;
 };
 
 // What a search that goes back looks for among the orders the links allow.
@@ -77,6 +88,10 @@ struct PlannerOptions {
   // margin is a distance query per pair of its triangles and those near it (a part of 50k
   // triangles: about 0.1 s a step). Parts authored as convex pieces are measured at any size.
   std::size_t margin_max_triangles = 50000;
+  // Replay the plan found, independently of the search, before it is called complete
+  // (plan_verifier.hpp); `verify_resolution`: its VerifyOptions::resolution.
+  bool verify = true;
+  double verify_resolution = 1.5e-4;
 };
 
 // Margins closer than this are taken as equal, m: Objective::margin takes an order as better

@@ -99,9 +99,11 @@ std::vector<Grasp> AssemblyScene::grasps(PartIndex part, const Vec3& direction) 
   return grasps_for(grasp_bounds_[part], product_.product.parts()[part].final_pose, direction, gripper_);
 }
 
-HeldPart AssemblyScene::hold(PartIndex part, const Grasp& grasp) const {
+const HeldPart& AssemblyScene::hold(PartIndex part, const Grasp& grasp) const {
+  auto [it, made] = held_.try_emplace({part, grasp.label, grasp.opening});
+  HeldPart& held = it->second;
+  if (!made) return held;
   const double margin = world_.options().shape_margin;
-  HeldPart held;
   if (const auto& mesh = product_.meshes[part]) held.with_arm.add_mesh("part", mesh, Pose::Identity(), margin);
   for (const auto& box : fb::gripper_boxes(gripper_, grasp.opening)) {
     const std::string member = box.name.rfind("finger", 0) == 0 ? "finger" : box.name;
@@ -147,7 +149,7 @@ std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajector
   const auto& w = trajectory.waypoints;
   if (w.empty()) return std::nullopt;
   if (!holds(part, trajectory.grasp)) return Collision{"", "finger", 0, "gripping"};
-  const HeldPart held = hold(part, trajectory.grasp);
+  const HeldPart& held = hold(part, trajectory.grasp);
   if (w.front().holding) {
     if (auto c = collision_at(held.with_arm, w.front().part, w.front().phase)) return c;
   }
@@ -190,7 +192,7 @@ std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& tr
     return !(c.member == "part" && c.normal.dot(direction) < -kAlongInsertion);
   };
   const auto& w = trajectory.waypoints;
-  const HeldPart held = hold(part, trajectory.grasp);
+  const HeldPart& held = hold(part, trajectory.grasp);
   std::size_t last = 0;  // the stretch that seats the part
   for (std::size_t i = 1; i < w.size(); ++i) last = w[i].holding ? i : last;
   std::optional<Margin> least;

@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <vector>
 
 #include "sim/collision/collision_world.hpp"
@@ -64,8 +65,10 @@ class AssemblyScene {
   // The gripper's grasps on the part (on what it holds it by) for a push along `direction`,
   // best first (grasp.hpp).
   std::vector<Grasp> grasps(PartIndex part, const Vec3& direction) const;
-  // The part in the gripper, held by `grasp`.
-  HeldPart hold(PartIndex part, const Grasp& grasp) const;
+  // The part in the gripper, held by `grasp`. Made once per part and grasp: a concave part's
+  // exact body (a convex child per triangle, 24 000 for a CAD beam) and its solid cost more to
+  // make than the checks that use them.
+  const HeldPart& hold(PartIndex part, const Grasp& grasp) const;
   std::optional<Collision> collision_at(const sim::MovingBody& body, const Pose& pose, const std::string& phase) const;
 
   // Whether the grasp's fingers both have the part's surface at their pads (a finger on a
@@ -116,6 +119,8 @@ class AssemblyScene {
   std::map<sim::BodyId, std::string> names_;
   // holds(), by part and grasp label (a label names one grasp of a part's box).
   mutable std::map<std::pair<PartIndex, std::string>, bool> holds_;
+  // hold(), by part, grasp label and opening.
+  mutable std::map<std::tuple<PartIndex, std::string, double>, HeldPart> held_;
   mutable std::map<PartIndex, std::set<std::string>> in_members_;  // grasps refused: the gripper in other members
 };
 

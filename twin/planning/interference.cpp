@@ -54,7 +54,7 @@ InterferenceCheck find_interferences(const LoadedProduct& product, const sim::Co
   std::map<const sim::TriangleMesh*, std::unique_ptr<Solid>> solids;
   const auto solid = [&](PartIndex i) -> const Solid& {
     auto& s = solids[product.meshes[i].get()];
-    if (!s) s = sim::solid_of(*product.meshes[i]);
+    if (!s) s = sim::solid_of(*product.meshes[i], true);
     return *s;
   };
   // A convex part (or one authored as convex pieces) is a volume to Bullet: when its hull

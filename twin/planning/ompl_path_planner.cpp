@@ -97,7 +97,7 @@ std::optional<Trajectory> OmplPathPlanner::next(const AssemblyScene& scene, Part
 std::optional<Trajectory> OmplPathPlanner::sample_path(const AssemblyScene& scene, PartIndex part,
                                                        const Grasp& grasp) const {
   const Pose goal = scene.product().product.parts()[part].final_pose;
-  const HeldPart held = scene.hold(part, grasp);
+  const HeldPart& held = scene.hold(part, grasp);
   const Eigen::AlignedBox3d part_box = scene.final_bounds(part);
   Eigen::AlignedBox3d around = scene.assembled_bounds();
   around.extend(part_box);

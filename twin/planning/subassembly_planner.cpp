@@ -232,8 +232,11 @@ Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequ
   plan.path_planner = path.name();
   plan.margin_threshold = options.margin_threshold;
   plan.margin_reach = options.margin_reach;
+  // The whole plan is replayed once its levels are joined (plan_assembly), not level by level.
+  PlannerOptions each = options;
+  each.verify = false;
   for (const PlanLevel& level : levels.levels) {
-    Plan own = plan_assembly(level.product, sequence, path, options);
+    Plan own = plan_assembly(level.product, sequence, path, each);
     for (PlanStep step : own.steps) {
       step.allowed = mapped(step.allowed, level.origin);
       if (!level.subassembly.empty()) {

@@ -107,3 +107,138 @@ write_obj("shaft-bearing/meshes/bearing.obj", "A bearing, 30 mm outside, 10.4 mm
 write_obj("shaft-bearing/meshes/shaft.obj", "A 10 mm shaft", *cylinder(5, 0, 60))
 write_obj("shaft-bearing/meshes/shaft_tight.obj", "An 11.2 mm shaft: 0.4 mm too thick for its 10.4 mm bores, all round", *cylinder(5.6, 0, 60))
 write_obj("shaft-bearing/meshes/pulley.obj", "A pulley, 40 mm across, 10.4 mm bore", *tube(20, 5.2, 0, 10))
+
+
+def stepped_post(sections):
+    """A prism along y of rectangular sections, centred on the y axis, one on the next:
+    `sections` lists (y0, y1, half x, half z) from the bottom up. One closed piece."""
+    vertices, triangles = [], []
+    rings = []  # per section: the 4 bottom corners, the 4 top corners (indices)
+    for y0, y1, hx, hz in sections:
+        corners = [(-hx, -hz), (hx, -hz), (hx, hz), (-hx, hz)]  # counter-clockwise seen from +y? see below
+        ring = []
+        for y in (y0, y1):
+            ring.append([len(vertices) + k for k in range(4)])
+            vertices += [(x, y, z) for x, z in corners]
+        rings.append(ring)
+        b, t = ring
+        for k in range(4):
+            j = (k + 1) % 4
+            triangles += [(b[k], t[k], t[j]), (b[k], t[j], b[j])]  # walls, outward
+    def annulus(outer, inner, up):
+        for k in range(4):
+            j = (k + 1) % 4
+            tris = [(outer[k], inner[k], inner[j]), (outer[k], inner[j], outer[j])]
+            triangles.extend(tris if up else [(a, c, b) for a, b, c in tris])
+    first, last = rings[0][0], rings[-1][1]
+    triangles += [(first[0], first[2], first[3]), (first[0], first[1], first[2])]   # bottom, -y
+    triangles += [(last[0], last[3], last[2]), (last[0], last[2], last[1])]         # top, +y
+    for (lower, upper), (s0, s1) in zip(zip(rings, rings[1:]), zip(sections, sections[1:])):
+        below_top, above_bottom = lower[1], upper[0]
+        if s0[2] >= s1[2]:   # the lower section is wider: its top shows round the upper's foot
+            annulus(below_top, above_bottom, True)
+        else:                # the upper one is wider: its underside shows round the lower's top
+            annulus(above_bottom, below_top, False)
+    return vertices, triangles
+
+
+def beam_with_mortises(length, height, depth, mortises):
+    """A beam along x (y 0..height, z +-depth/2) with rectangular through-holes along y:
+    `mortises` lists (x centre, half x, half z). One closed piece: the top and bottom are
+    cut into cells at the holes, and the long sides split at the same x so no edge ends
+    on another."""
+    hd = depth / 2
+    xs = [-length / 2]
+    cells = []
+    for xc, hx, hz in sorted(mortises):
+        cell_half = hx + 2
+        xs += [xc - cell_half, xc + cell_half]
+        cells.append((xc - cell_half, xc + cell_half, xc, hx, hz))
+    xs.append(length / 2)
+    vertices, triangles = [], []
+    index = {}
+    def v(x, y, z):
+        key = (round(x, 9), round(y, 9), round(z, 9))
+        if key not in index:
+            index[key] = len(vertices)
+            vertices.append((x, y, z))
+        return index[key]
+    def quad(a, b, c, d):  # counter-clockwise seen from outside
+        triangles.extend([(a, b, c), (a, c, d)])
+    for y, up in ((height, True), (0.0, False)):
+        def face(a, b, c, d):
+            if up:
+                quad(a, b, c, d)
+            else:
+                quad(a, d, c, b)
+        for x0, x1 in zip(xs, xs[1:]):
+            hole = next((c for c in cells if abs(c[0] - x0) < 1e-9), None)
+            if hole is None:
+                face(v(x0, y, hd), v(x1, y, hd), v(x1, y, -hd), v(x0, y, -hd))
+                continue
+            _, _, xc, hx, hz = hole
+            o = [v(x0, y, hd), v(x1, y, hd), v(x1, y, -hd), v(x0, y, -hd)]
+            i = [v(xc - hx, y, hz), v(xc + hx, y, hz), v(xc + hx, y, -hz), v(xc - hx, y, -hz)]
+            for k in range(4):
+                j = (k + 1) % 4
+                face(o[k], o[j], i[j], i[k])
+    for x0, x1 in zip(xs, xs[1:]):
+        quad(v(x0, 0, hd), v(x1, 0, hd), v(x1, height, hd), v(x0, height, hd))        # +z side
+        quad(v(x0, 0, -hd), v(x0, height, -hd), v(x1, height, -hd), v(x1, 0, -hd))    # -z side
+    L = length / 2
+    quad(v(L, 0, hd), v(L, 0, -hd), v(L, height, -hd), v(L, height, hd))              # +x end
+    quad(v(-L, 0, hd), v(-L, height, hd), v(-L, height, -hd), v(-L, 0, -hd))          # -x end
+    for _, _, xc, hx, hz in cells:   # hole walls, facing into the hole
+        c = [(xc - hx, hz), (xc + hx, hz), (xc + hx, -hz), (xc - hx, -hz)]
+        for k in range(4):
+            (xa, za), (xb, zb) = c[k], c[(k + 1) % 4]
+            quad(v(xa, 0, za), v(xa, height, za), v(xb, height, zb), v(xb, 0, zb))
+    return vertices, triangles
+
+
+# Beam frame: a base beam with two through mortises 5 x 4 mm, two posts 12.7 mm square and
+# 76 mm tall with tenons 5 x 4 x 20 mm at both ends, a top beam like the base, and a board
+# on top. The posts' bottom tenons fill the base's mortises to its underside, so they stand
+# on the station where the base will be: only the base can come first.
+tenon = (2.5, 2.0)
+write_obj("beam-frame/meshes/beam.obj", "A beam 200 x 20 x 20 mm with two through mortises 5 x 4 mm, 160 mm apart",
+          *beam_with_mortises(200, 20, 20, [(-80, *tenon), (80, *tenon)]))
+write_obj("beam-frame/meshes/post.obj", "A post 12.7 mm square, 76 mm tall, tenons 5 x 4 x 20 mm at both ends",
+          *stepped_post([(0, 20, *tenon), (20, 96, 6.35, 6.35), (96, 116, *tenon)]))
+write_obj("beam-frame/meshes/board.obj", "A board 200 x 6 x 40 mm",
+          *stepped_post([(0, 6, 100, 20)]))
+
+
+def write_faceted_obj(path, note, vertices, triangles):
+    """The mesh as a CAD export that writes every face as an object of its own: one `o` per
+    plane of triangles, each with its own copies of the corners. The objects are not convex
+    pieces; together they close one concave solid."""
+    groups = {}
+    for t in triangles:
+        a, b, c = (vertices[i] for i in t)
+        n = [(b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
+             (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
+             (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])]
+        length = math.sqrt(sum(x * x for x in n))
+        n = tuple(round(x / length, 6) for x in n)
+        key = n + (round(sum(n[k] * a[k] for k in range(3)), 4),)
+        groups.setdefault(key, []).append(t)
+    with open(path, "w") as out:
+        out.write(f"# {note}; millimetres; one object per face, generated by make_concave_meshes.py\n")
+        base = 1
+        for g, (key, tris) in enumerate(sorted(groups.items())):
+            used = sorted({i for t in tris for i in t})
+            local = {i: base + k for k, i in enumerate(used)}
+            out.write(f"o face_{g}\n")
+            for i in used:
+                out.write("v %.6f %.6f %.6f\n" % vertices[i])
+            for t in tris:
+                out.write("f %d %d %d\n" % tuple(local[i] for i in t))
+            base += len(used)
+
+
+# The beam frame again, as a CAD system that writes one object per face exports it.
+write_faceted_obj("beam-frame/meshes/beam_faces.obj", "The beam of beam.obj",
+                  *beam_with_mortises(200, 20, 20, [(-80, *tenon), (80, *tenon)]))
+write_faceted_obj("beam-frame/meshes/post_faces.obj", "The post of post.obj",
+                  *stepped_post([(0, 20, *tenon), (20, 96, 6.35, 6.35), (96, 116, *tenon)]))

@@ -1,0 +1,648 @@
+#include "twin/planning/plan_verifier.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/convex_hull_3.h>
+
+#include "sim/collision/collision_world.hpp"
+#include "sim/mesh/solid.hpp"
+
+namespace twin {
+namespace {
+
+using Triangle = std::array<Vec3, 3>;
+using Kernel = sim::SolidKernel;
+
+// A shape has its triangles looked up by box through a tree past this many.
+constexpr std::size_t kTreeFrom = 64;
+// m between the poses at which a violation's depth is followed along its move, and how many.
+constexpr double kDepthStep = 0.001;
+constexpr int kDepthPoses = 20;
+
+CGAL::Bbox_3 bbox(const Eigen::AlignedBox3d& b) {
+  return {b.min().x(), b.min().y(), b.min().z(), b.max().x(), b.max().y(), b.max().z()};
+}
+
+Eigen::AlignedBox3d box_of(const Triangle& t) {
+  Eigen::AlignedBox3d b(t[0]);
+  b.extend(t[1]);
+  b.extend(t[2]);
+  return b;
+}
+
+// The box around a box moved by the pose.
+Eigen::AlignedBox3d moved_box(const Eigen::AlignedBox3d& box, const Pose& pose) {
+  if (box.isEmpty()) return box;
+  const Vec3 centre = pose * box.center();
+  const Vec3 half = pose.linear().cwiseAbs() * (box.sizes() / 2);
+  return {centre - half, centre + half};
+}
+
+Triangle moved(Triangle t, const Pose& pose) {
+  for (Vec3& v : t) v = pose * v;
+  return t;
+}
+
+// A closed shape of the replay, in its own frame: a part's mesh where it is one piece, each
+// piece where the mesh is authored as convex pieces (its hull where the piece is not closed
+// and convex: planning takes the hulls), a gripper's box, the station's slab.
+class Shape {
+ public:
+  // `convex`: the mesh is one closed convex piece.
+  Shape(const sim::TriangleMesh& mesh, bool convex) {
+    for (const auto& t : mesh.triangles) {
+      triangles_.push_back({mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]});
+      boxes_.push_back(box_of(triangles_.back()));
+    }
+    corners_ = mesh.vertices;
+    for (const Vec3& v : mesh.vertices) {
+      box_.extend(v);
+      radius_ = std::max(radius_, v.norm());
+    }
+    // The mesh is kept for a solid where one is asked for: a concave shape's depth, a large
+    // one's triangle tree.
+    if (!convex || triangles_.size() >= kTreeFrom) mesh_ = std::make_unique<sim::TriangleMesh>(mesh);
+    if (!convex) return;
+    double volume = 0;  // signed: positive when wound outwards
+    for (const auto& t : triangles_) volume += t[0].dot(t[1].cross(t[2]));
+    for (const auto& t : triangles_) {
+      const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+      if (n.norm() < 1e-18) continue;
+      const Vec3 outward = n.normalized() * (volume < 0 ? -1 : 1);
+      planes_.emplace_back(outward, outward.dot(t[0]));
+    }
+  }
+
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+  const std::vector<Vec3>& corners() const { return corners_; }
+  const Eigen::AlignedBox3d& box() const { return box_; }
+  double radius() const { return radius_; }
+  bool convex() const { return !planes_.empty(); }
+
+  // The triangles whose boxes meet `box` (own frame).
+  void near(const Eigen::AlignedBox3d& box, std::vector<std::size_t>& out) const {
+    out.clear();
+    if (triangles_.size() < kTreeFrom) {
+      for (std::size_t i = 0; i < boxes_.size(); ++i) {
+        if (boxes_[i].intersects(box)) out.push_back(i);
+      }
+      return;
+    }
+    std::vector<sim::Solid::Tree::Primitive_id> faces;
+    solid().surface->all_intersected_primitives(bbox(box), std::back_inserter(faces));
+    for (auto f : faces) out.push_back(static_cast<std::size_t>(f.idx()));
+  }
+
+  // A point of the triangle (own frame) inside, deeper than `floor`: the first found, or with
+  // `deepest` the deepest (sim::deepest_inside). A convex shape's depth at a point is the
+  // least of d - n.x over its planes, and d - n.x at the corners bounds a piece of the
+  // triangle.
+  std::optional<sim::DeepPoint> deeper_than(const Triangle& triangle, double floor, double resolution, bool deepest) const {
+    if (!convex()) return sim::deepest_inside(solid(), triangle, floor, resolution, deepest);
+    std::optional<sim::DeepPoint> found;
+    std::vector<Triangle> pieces{triangle};
+    while (!pieces.empty()) {
+      const Triangle t = pieces.back();
+      pieces.pop_back();
+      double bound = std::numeric_limits<double>::infinity();
+      for (const auto& [n, d] : planes_) bound = std::min(bound, std::max({d - n.dot(t[0]), d - n.dot(t[1]), d - n.dot(t[2])}));
+      if (bound <= floor) continue;
+      const Vec3 middle = (t[0] + t[1] + t[2]) / 3;
+      double depth = std::numeric_limits<double>::infinity();
+      for (const auto& [n, d] : planes_) depth = std::min(depth, d - n.dot(middle));
+      if (depth > floor) {
+        found = sim::DeepPoint{depth, middle};
+        if (!deepest) return found;
+        floor = depth + resolution;  // the deepest, to within the resolution
+      }
+      if (std::max({(t[0] - middle).norm(), (t[1] - middle).norm(), (t[2] - middle).norm()}) <= resolution) continue;
+      const Vec3 ab = (t[0] + t[1]) / 2, bc = (t[1] + t[2]) / 2, ca = (t[2] + t[0]) / 2;
+      pieces.insert(pieces.end(), {{t[0], ab, ca}, {ab, t[1], bc}, {ca, bc, t[2]}, {ab, bc, ca}});
+    }
+    return found;
+  }
+
+  // How deep a point (own frame) lies inside; 0 outside.
+  double depth(const Vec3& p) const {
+    if (!convex()) return solid().depth(p, 0);
+    double depth = std::numeric_limits<double>::infinity();
+    for (const auto& [n, d] : planes_) depth = std::min(depth, d - n.dot(p));
+    return std::max(0.0, depth);
+  }
+
+  // Whether the shape has an inside: a mesh that is not closed has none, and what crosses
+  // its surface cannot be measured.
+  bool closed() const { return convex() || solid().inside != nullptr; }
+  bool crosses(const Triangle& t) const {
+    return solid().surface->do_intersect(Kernel::Triangle_3({t[0].x(), t[0].y(), t[0].z()}, {t[1].x(), t[1].y(), t[1].z()},
+                                                            {t[2].x(), t[2].y(), t[2].z()}));
+  }
+
+ private:
+  const sim::Solid& solid() const {
+    if (!solid_) solid_ = sim::solid_of(*mesh_);
+    return *solid_;
+  }
+
+  std::unique_ptr<sim::TriangleMesh> mesh_;
+  std::vector<Triangle> triangles_;
+  std::vector<Vec3> corners_;
+  std::vector<Eigen::AlignedBox3d> boxes_;
+  Eigen::AlignedBox3d box_;
+  double radius_ = 0;
+  std::vector<std::pair<Vec3, double>> planes_;  // a convex shape's: outward normal n, offset d
+  mutable std::unique_ptr<sim::Solid> solid_;
+};
+
+sim::TriangleMesh box_mesh(const Vec3& half, const Pose& pose) {
+  sim::TriangleMesh m;
+  for (int i = 0; i < 8; ++i) {
+    m.vertices.push_back(pose * Vec3(i & 1 ? half.x() : -half.x(), i & 2 ? half.y() : -half.y(), i & 4 ? half.z() : -half.z()));
+  }
+  for (const auto& f : std::vector<std::array<std::uint32_t, 4>>{
+           {0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}}) {
+    m.triangles.push_back({f[0], f[1], f[2]});
+    m.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return m;
+}
+
+// Whether the mesh closes a convex solid: every edge has its reverse, and every corner lies on
+// the inner side of every face (a box, a prism, a wedge of a plate round a hole).
+bool closed_convex(const sim::TriangleMesh& mesh) {
+  if (mesh.triangles.size() < 4) return false;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) edges.emplace_back(t[k], t[(k + 1) % 3]);
+  }
+  std::sort(edges.begin(), edges.end());
+  if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
+  for (const auto& [a, b] : edges) {
+    if (!std::binary_search(edges.begin(), edges.end(), std::pair{b, a})) return false;
+  }
+  double volume = 0;  // signed: positive when wound outwards
+  const auto& v = mesh.vertices;
+  for (const auto& t : mesh.triangles) volume += v[t[0]].dot(v[t[1]].cross(v[t[2]]));
+  if (volume <= 0) return false;
+  const double slack = 1e-9 * (mesh.bounds.isEmpty() ? 1.0 : std::max(1.0, mesh.bounds.sizes().maxCoeff()));
+  for (const auto& t : mesh.triangles) {
+    const Vec3 n = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
+    if (n.squaredNorm() == 0) continue;
+    const Vec3 u = n.normalized();
+    for (const Vec3& p : v) {
+      if (u.dot(p - v[t[0]]) > slack) return false;
+    }
+  }
+  return true;
+}
+
+// One piece of a mesh authored as pieces, as its own mesh: its triangles where they close a
+// convex solid, else its hull (planning takes each piece's hull).
+sim::TriangleMesh piece_mesh(const sim::TriangleMesh& mesh, const std::vector<std::uint32_t>& piece) {
+  std::vector<std::uint32_t> index(mesh.vertices.size(), ~0u);
+  sim::TriangleMesh out;
+  for (auto v : piece) {
+    index[v] = static_cast<std::uint32_t>(out.vertices.size());
+    out.vertices.push_back(mesh.vertices[v]);
+  }
+  for (const auto& t : mesh.triangles) {
+    if (index[t[0]] != ~0u && index[t[1]] != ~0u && index[t[2]] != ~0u) out.triangles.push_back({index[t[0]], index[t[1]], index[t[2]]});
+  }
+  if (closed_convex(out)) return out;
+  using Exact = CGAL::Exact_predicates_inexact_constructions_kernel;
+  std::vector<Exact::Point_3> points;
+  for (const Vec3& v : out.vertices) points.emplace_back(v.x(), v.y(), v.z());
+  CGAL::Surface_mesh<Exact::Point_3> hull;
+  CGAL::convex_hull_3(points.begin(), points.end(), hull);
+  sim::TriangleMesh h;
+  std::map<CGAL::Surface_mesh<Exact::Point_3>::Vertex_index, std::uint32_t> at;
+  for (auto v : hull.vertices()) {
+    at[v] = static_cast<std::uint32_t>(h.vertices.size());
+    const auto& p = hull.point(v);
+    h.vertices.emplace_back(p.x(), p.y(), p.z());
+  }
+  for (auto f : hull.faces()) {
+    std::vector<std::uint32_t> corners;
+    for (auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) corners.push_back(at[v]);
+    for (std::size_t k = 1; k + 1 < corners.size(); ++k) h.triangles.push_back({corners[0], corners[k], corners[k + 1]});
+  }
+  return h;
+}
+
+bool degenerate(const Triangle& t) { return (t[1] - t[0]).cross(t[2] - t[0]).squaredNorm() < 1e-24; }
+
+Kernel::Triangle_3 cgal_triangle(const Triangle& t) {
+  return {{t[0].x(), t[0].y(), t[0].z()}, {t[1].x(), t[1].y(), t[1].z()}, {t[2].x(), t[2].y(), t[2].z()}};
+}
+
+// Whether a plane keeps the two triangles apart all along the move (they may touch it): then
+// their surfaces never cross there (a finger backing away along the face it held, a face
+// sliding on a face). The planes tried are the triangles' own and those through an edge of
+// each.
+bool stays_apart(const Triangle& t, const Vec3& shift, const Triangle& s) {
+  constexpr double kTouching = 1e-7;  // m: a tenth of a micrometre
+  std::array<Vec3, 11> axes;
+  axes[0] = (t[1] - t[0]).cross(t[2] - t[0]);
+  axes[1] = (s[1] - s[0]).cross(s[2] - s[0]);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) axes[2 + 3 * i + j] = (t[(i + 1) % 3] - t[i]).cross(s[(j + 1) % 3] - s[j]);
+  }
+  for (Vec3 n : axes) {
+    if (n.squaredNorm() < 1e-30) continue;
+    n.normalize();
+    double t_lo = n.dot(t[0]), t_hi = t_lo, s_lo = n.dot(s[0]), s_hi = s_lo;
+    for (int k = 1; k < 3; ++k) {
+      t_lo = std::min(t_lo, n.dot(t[k]));
+      t_hi = std::max(t_hi, n.dot(t[k]));
+      s_lo = std::min(s_lo, n.dot(s[k]));
+      s_hi = std::max(s_hi, n.dot(s[k]));
+    }
+    const double along = n.dot(shift);
+    if (t_lo >= s_hi - kTouching && along >= -kTouching) return true;
+    if (t_hi <= s_lo + kTouching && along <= kTouching) return true;
+  }
+  return false;
+}
+
+// Whether the triangle `s` meets the prism that triangle `t` sweeps moving by `shift` (every
+// point of t + u shift, u in 0..1): it crosses one of the prism's faces, or lies inside it.
+bool prism_meets(const Triangle& t, const Vec3& shift, const Triangle& s) {
+  if (stays_apart(t, shift, s)) return false;
+  const auto cs = cgal_triangle(s);
+  const auto meets = [&](const Triangle& face) { return !degenerate(face) && CGAL::do_intersect(cgal_triangle(face), cs); };
+  const Triangle end{t[0] + shift, t[1] + shift, t[2] + shift};
+  if (meets(t) || meets(end)) return true;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 &a = t[k], &b = t[(k + 1) % 3];
+    if (meets({a, b, b + shift}) || meets({a, b + shift, a + shift})) return true;
+  }
+  // Inside: on the inner side of the five faces (a prism with no volume has no inside).
+  Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+  const double height = n.dot(shift);
+  if (std::abs(height) < 1e-18) return false;
+  if (height < 0) n = -n;
+  const Vec3 middle = (t[0] + t[1] + t[2]) / 3 + shift / 2;
+  for (const Vec3& p : s) {
+    if (n.dot(p - t[0]) <= 0 || n.dot(p - end[0]) >= 0) continue;
+    bool inside = true;
+    for (int k = 0; k < 3 && inside; ++k) {
+      const Vec3 &a = t[k], &b = t[(k + 1) % 3];
+      Vec3 side = (b - a).cross(shift);
+      if (side.dot(middle - a) < 0) side = -side;
+      inside = side.dot(p - a) > 0;
+    }
+    if (inside) return true;
+  }
+  return false;
+}
+
+// A named group of shapes: a part (its pieces), a box of the gripper, the station.
+struct Body {
+  std::string name;
+  const std::vector<std::unique_ptr<Shape>>* shapes;
+  Pose offset = Pose::Identity();  // a moving body's, from the pose it moves by
+  Eigen::AlignedBox3d box;         // own frame
+};
+
+// An obstacle where it stands, for the move checked: its box and each shape's (world).
+struct Placed {
+  const Body* body;
+  Pose pose;
+  Eigen::AlignedBox3d box;
+  std::vector<Eigen::AlignedBox3d> shape_boxes;
+};
+
+class Replay {
+ public:
+  Replay(const LoadedProduct& product, const Plan& plan, const VerifyOptions& options)
+      : product_(product), plan_(plan), options_(options) {
+    // The station: a slab whose top is the assembly surface, as planning has it.
+    Pose slab = Pose::Identity();
+    slab.translation() = Vec3(0, -0.025, 0);
+    station_shapes_.push_back(std::make_unique<Shape>(box_mesh(Vec3(1.0, 0.025, 1.0), slab), true));
+    station_ = {"station", &station_shapes_, Pose::Identity(), station_shapes_.front()->box()};
+  }
+
+  Verification run() {
+    placed_.assign(product_.product.parts().size(), std::nullopt);
+    for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
+      if (auto violation = replay(plan_.steps[i])) {
+        violation->step = i + 1;
+        result_.violations.push_back(*violation);
+      }
+    }
+    result_.verified = result_.violations.empty() && plan_.complete;
+    return std::move(result_);
+  }
+
+ private:
+  const Body& part_body(PartIndex part) {
+    auto [it, inserted] = parts_.try_emplace(part);
+    Body& body = it->second;
+    if (!inserted) return body;
+    body.name = product_.product.parts()[part].name;
+    const auto& mesh = product_.meshes[part];
+    auto [shapes, made] = shapes_.try_emplace(mesh.get());
+    if (made && mesh) {
+      if (mesh->pieces.size() > 1) {
+        for (const auto& piece : mesh->pieces) {
+          const sim::TriangleMesh own = piece_mesh(*mesh, piece);
+          shapes->second.push_back(std::make_unique<Shape>(own, own.triangles.size() >= 4));
+        }
+      } else {
+        shapes->second.push_back(std::make_unique<Shape>(*mesh, mesh->convex));
+      }
+    }
+    body.shapes = &shapes->second;
+    for (const auto& s : *body.shapes) body.box.extend(s->box());
+    return body;
+  }
+
+  const std::vector<Body>& gripper(double opening) {
+    auto [it, inserted] = grippers_.try_emplace(opening);
+    if (inserted) {
+      const auto boxes = fb::gripper_boxes(options_.gripper, opening);
+      it->second.shapes.resize(boxes.size());
+      for (std::size_t b = 0; b < boxes.size(); ++b) {
+        it->second.shapes[b].push_back(std::make_unique<Shape>(box_mesh(boxes[b].half_extents, boxes[b].pose), true));
+        const std::string member = boxes[b].name.rfind("finger", 0) == 0 ? "finger" : boxes[b].name;
+        it->second.bodies.push_back({member, &it->second.shapes[b], Pose::Identity(), it->second.shapes[b].front()->box()});
+      }
+    }
+    return it->second.bodies;
+  }
+
+  std::vector<Placed> obstacles() {
+    std::vector<Placed> out;
+    const auto add = [&](const Body& body, const Pose& pose) {
+      Placed o{&body, pose, moved_box(body.box, pose), {}};
+      for (const auto& s : *body.shapes) o.shape_boxes.push_back(moved_box(s->box(), pose));
+      out.push_back(std::move(o));
+    };
+    add(station_, Pose::Identity());
+    for (PartIndex p = 0; p < placed_.size(); ++p) {
+      if (placed_[p]) add(part_body(p), *placed_[p]);
+    }
+    return out;
+  }
+
+  std::optional<Violation> replay(const PlanStep& step) {
+    const auto& parts = product_.product.parts();
+    const auto& w = step.trajectory.waypoints;
+    // What the gripper holds, in the held part's frame: the part, and a subassembly's other
+    // members where they stand relative to it in the finished product.
+    std::vector<std::pair<PartIndex, Pose>> carried{{step.part, Pose::Identity()}};
+    for (PartIndex m : step.carried) carried.emplace_back(m, parts[step.part].final_pose.inverse() * parts[m].final_pose);
+    std::vector<Body> holding, alone;
+    for (const auto& [p, offset] : carried) {
+      placed_[p].reset();
+      Body held = part_body(p);
+      held.offset = offset;
+      holding.push_back(held);
+    }
+    for (const Body& g : gripper(step.trajectory.grasp.opening)) {
+      alone.push_back(g);
+      Body held = g;
+      held.offset = step.trajectory.grasp.gripper;
+      holding.push_back(held);
+    }
+    std::optional<Violation> found;
+    std::vector<Placed> around = obstacles();
+    bool released = false;
+    if (!w.empty() && w.front().holding) found = at_pose(holding, w.front().part, around, w.front().phase);
+    for (std::size_t i = 1; i < w.size() && !found; ++i) {
+      if (!w[i].holding && !released) {
+        // Let go: the part stays where the last held waypoint put it.
+        released = true;
+        for (const auto& [p, offset] : carried) placed_[p] = w[i - 1].part * offset;
+        around = obstacles();
+      }
+      found = w[i].holding ? along(holding, w[i - 1].part, w[i].part, around, w[i].phase)
+                           : along(alone, w[i - 1].gripper, w[i].gripper, around, w[i].phase);
+    }
+    if (!released && !w.empty()) {
+      for (const auto& [p, offset] : carried) placed_[p] = w.back().part * offset;
+    }
+    return found;
+  }
+
+  // The first member at `pose` that goes into an obstacle past the tolerance, how deep.
+  std::optional<Violation> at_pose(const std::vector<Body>& members, const Pose& pose, const std::vector<Placed>& around,
+                                   const std::string& phase) {
+    ++result_.poses;
+    for (const Body& m : members) {
+      const Pose at = pose * m.offset;
+      const Eigen::AlignedBox3d box = moved_box(m.box, at);
+      for (const Placed& o : around) {
+        if (!box.intersects(o.box)) continue;
+        for (const auto& a : *m.shapes) {
+          const Eigen::AlignedBox3d a_box = moved_box(a->box(), at);
+          if (!a_box.intersects(o.box)) continue;
+          for (std::size_t k = 0; k < o.body->shapes->size(); ++k) {
+            if (!a_box.intersects(o.shape_boxes[k])) continue;
+            if (auto deep = deeper(*a, at, *(*o.body->shapes)[k], o.pose, options_.contact_tolerance, o.body == &station_)) {
+              return Violation{0, phase, m.name, o.body->name, deep->depth, deep->point};
+            }
+          }
+        }
+      }
+    }
+    return std::nullopt;
+  }
+
+  // A point of either shape inside the other (world) deeper than `floor`: the first found, or
+  // with `deepest` the deepest. The station's slab is asked one way (`b_one_way`): its faces
+  // are two metres wide, and a part reaches into it only by its own surface.
+  std::optional<sim::DeepPoint> deeper(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, double floor,
+                                       bool b_one_way, bool deepest = false) {
+    std::optional<sim::DeepPoint> found;
+    for (int way = 0; way < (b_one_way ? 1 : 2); ++way) {
+      const Shape& x = way ? b : a;
+      const Shape& y = way ? a : b;
+      const Pose& py = way ? pa : pb;
+      const Pose to_y = py.inverse() * (way ? pb : pa);
+      // x's triangles near y, in y's frame.
+      x.near(moved_box(y.box(), to_y.inverse()), near_);
+      const bool measurable = y.closed();
+      for (std::size_t i : near_) {
+        const Triangle t = moved(x.triangles()[i], to_y);
+        if (!measurable) {
+          // No inside to measure: a surface crossing it counts.
+          if (!degenerate(t) && y.crosses(t)) return sim::DeepPoint{0, py * t[0]};
+          continue;
+        }
+        if (const auto deep = y.deeper_than(t, floor, options_.resolution, deepest)) {
+          found = sim::DeepPoint{deep->depth, py * deep->point};
+          if (!deepest) return found;
+          floor = deep->depth + options_.resolution;
+        }
+      }
+    }
+    return found;
+  }
+
+  // Whether any member's surface can meet an obstacle's while the members translate by
+  // `shift` (world) from `pose`.
+  bool may_touch(const std::vector<Body>& members, const Pose& pose, const Vec3& shift, const std::vector<Placed>& around) {
+    ++result_.sweeps;
+    const auto swept = [&](Eigen::AlignedBox3d box) {
+      box.extend(box.min() + shift);
+      box.extend(box.max() + shift);
+      return box;
+    };
+    for (const Body& m : members) {
+      const Pose at = pose * m.offset;
+      const Eigen::AlignedBox3d m_swept = swept(moved_box(m.box, at));
+      if (std::none_of(around.begin(), around.end(), [&](const Placed& o) { return m_swept.intersects(o.box); })) continue;
+      for (const auto& a : *m.shapes) {
+        const Eigen::AlignedBox3d a_swept = swept(moved_box(a->box(), at));
+        for (const Placed& o : around) {
+          if (!a_swept.intersects(o.box)) continue;
+          for (std::size_t k = 0; k < o.body->shapes->size(); ++k) {
+            if (a_swept.intersects(o.shape_boxes[k]) && sweep_meets(*a, at, shift, *(*o.body->shapes)[k], o.pose)) return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+  bool sweep_meets(const Shape& a, const Pose& at, const Vec3& shift, const Shape& b, const Pose& pb) {
+    const Pose to_b = pb.inverse() * at;
+    const Vec3 shift_b = pb.linear().transpose() * shift;
+    // a's triangles whose sweep comes within b's box, in a's frame.
+    Eigen::AlignedBox3d near = moved_box(b.box(), to_b.inverse());
+    const Vec3 back = -(to_b.linear().transpose() * shift_b);
+    near.extend(near.min() + back);
+    near.extend(near.max() + back);
+    a.near(near, near_);
+    for (std::size_t i : near_) {
+      const Triangle t = moved(a.triangles()[i], to_b);
+      Eigen::AlignedBox3d prism = box_of(t);
+      prism.extend(prism.min() + shift_b);
+      prism.extend(prism.max() + shift_b);
+      b.near(prism, against_);
+      for (std::size_t j : against_) {
+        if (prism_meets(t, shift_b, b.triangles()[j])) return true;
+      }
+    }
+    return false;
+  }
+
+  std::optional<Violation> along(const std::vector<Body>& members, const Pose& from, const Pose& to,
+                                 const std::vector<Placed>& around, const std::string& phase) {
+    double radius = 0;
+    for (const Body& m : members) {
+      for (const auto& s : *m.shapes) radius = std::max(radius, m.offset.translation().norm() + s->radius());
+    }
+    const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
+    const Vec3 shift = to.translation() - from.translation();
+    const double travel = shift.norm() + angle * radius;
+    const double step = options_.resolution;
+    if (angle > 1e-12) {
+      // Turning: pose by pose, no point moving more than the resolution between them.
+      const int n = std::max(1, static_cast<int>(std::ceil(travel / step)));
+      for (int k = 1; k <= n; ++k) {
+        if (auto v = at_pose(members, sim::interpolate(from, to, double(k) / n), around, phase)) return v;
+      }
+      return std::nullopt;
+    }
+    // Straight: a stretch along which no surface can meet another is clear whole; one where
+    // they may is halved, down to the resolution, and its poses measured. The pose at `s0`
+    // is known clear.
+    std::optional<Violation> found;
+    double at = 0;  // where along the move the first violation is
+    const auto check = [&](auto&& self, double s0, double s1) -> bool {
+      if (!may_touch(members, sim::interpolate(from, to, s0), shift * (s1 - s0), around)) return true;
+      if ((s1 - s0) * travel <= step) {
+        found = at_pose(members, sim::interpolate(from, to, s1), around, phase);
+        at = s1;
+        return !found;
+      }
+      const double mid = (s0 + s1) / 2;
+      return self(self, s0, mid) && self(self, mid, s1);
+    };
+    if (travel > 0) check(check, 0.0, 1.0);
+    if (found) deepest_after(*found, members, from, to, at, travel, around);
+    return found;
+  }
+
+  // A violation is found where it begins, barely past the tolerance; the designer wants to
+  // know how deep the move goes. The rest of the move is sampled (every millimetre, at most
+  // kDepthPoses poses) and at each pose the corners of either shape inside the other are
+  // measured: the depth said is the deepest found, a least one.
+  void deepest_after(Violation& v, const std::vector<Body>& members, const Pose& from, const Pose& to, double at,
+                     double travel, const std::vector<Placed>& around) {
+    const int n = std::min(kDepthPoses, static_cast<int>(std::ceil((1 - at) * travel / kDepthStep)));
+    for (int k = 0; k <= n; ++k) {
+      const Pose pose = sim::interpolate(from, to, n == 0 ? at : at + (1 - at) * k / n);
+      for (const Body& m : members) {
+        if (m.name != v.member) continue;
+        const Pose p = pose * m.offset;
+        for (const Placed& o : around) {
+          if (o.body->name != v.with || !moved_box(m.box, p).intersects(o.box)) continue;
+          for (const auto& a : *m.shapes) {
+            for (const auto& b : *o.body->shapes) {
+              deepest_corner(*a, p, *b, o.pose, v);
+              if (o.body != &station_) deepest_corner(*b, o.pose, *a, p, v);
+            }
+          }
+        }
+      }
+    }
+  }
+
+  // The corners of x that lie in y deeper than the violation says.
+  void deepest_corner(const Shape& x, const Pose& px, const Shape& y, const Pose& py, Violation& v) {
+    const Pose to_y = py.inverse() * px;
+    const Eigen::AlignedBox3d box = y.box();
+    for (const Vec3& corner : x.corners()) {
+      const Vec3 c = to_y * corner;
+      if (!box.contains(c)) continue;
+      const double depth = y.depth(c);
+      if (depth > v.depth) {
+        v.depth = depth;
+        v.where = py * c;
+      }
+    }
+  }
+
+  const LoadedProduct& product_;
+  const Plan& plan_;
+  const VerifyOptions& options_;
+  Verification result_;
+  std::vector<std::unique_ptr<Shape>> station_shapes_;
+  Body station_;
+  std::map<const sim::TriangleMesh*, std::vector<std::unique_ptr<Shape>>> shapes_;
+  std::map<PartIndex, Body> parts_;
+  struct Gripper {
+    std::vector<std::vector<std::unique_ptr<Shape>>> shapes;
+    std::vector<Body> bodies;
+  };
+  std::map<double, Gripper> grippers_;
+  std::vector<std::optional<Pose>> placed_;
+  std::vector<std::size_t> near_, against_;  // kept between calls: no allocation per query
+};
+
+}  // namespace
+
+std::string describe(const Product& product, const Violation& v) {
+  (void)product;
+  char depth[32];
+  std::snprintf(depth, sizeof depth, "%.2f mm", v.depth * 1000);
+  const bool part = v.member != "finger" && v.member != "palm" && v.member != "carriage";
+  return "step " + std::to_string(v.step) + ": the " + (part ? v.member : "gripper's " + v.member) + " went " +
+         (v.depth > 0 ? std::string(depth) + " into " : "through the open surface of ") + v.with + " while " + v.phase;
+}
+
+Verification verify_plan(const LoadedProduct& product, const Plan& plan, const VerifyOptions& options) {
+  return Replay(product, plan, options).run();
+}
+
+}  // namespace twin
