@@ -96,6 +96,58 @@ void orient(TriangleMesh& mesh,
   mesh.repairs.flipped = static_cast<std::size_t>(std::count(turned.begin(), turned.end(), true));
 }
 
+// Whether every piece closes a convex solid of its own (a decomposition authored as such).
+bool convex_pieces(const TriangleMesh& mesh) {
+  std::vector<std::size_t> piece_of(mesh.vertices.size(), 0);
+  std::vector<std::vector<std::uint32_t>> index(mesh.pieces.size());  // each piece's vertices, sorted
+  std::vector<TriangleMesh> own(mesh.pieces.size());
+  for (std::size_t p = 0; p < mesh.pieces.size(); ++p) {
+    index[p] = mesh.pieces[p];
+    std::sort(index[p].begin(), index[p].end());
+    own[p].pieces.emplace_back();
+    for (auto v : index[p]) {
+      piece_of[v] = p;
+      own[p].pieces.back().push_back(static_cast<std::uint32_t>(own[p].vertices.size()));
+      own[p].vertices.push_back(mesh.vertices[v]);
+    }
+  }
+  const auto local = [&](std::size_t p, std::uint32_t v) {
+    return static_cast<std::uint32_t>(std::lower_bound(index[p].begin(), index[p].end(), v) - index[p].begin());
+  };
+  for (const auto& t : mesh.triangles) {
+    const std::size_t p = piece_of[t[0]];
+    if (piece_of[t[1]] != p || piece_of[t[2]] != p) return false;  // a triangle across objects
+    own[p].triangles.push_back({local(p, t[0]), local(p, t[1]), local(p, t[2])});
+  }
+  for (const TriangleMesh& piece : own) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    for (const auto& t : piece.triangles) {
+      for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+    }
+    if (uses.empty() || std::any_of(uses.begin(), uses.end(), [](const auto& u) { return u.second != 2; })) return false;
+    if (!is_convex(piece)) return false;
+  }
+  return true;
+}
+
+// One piece of all the objects, their corners welded where they coincide.
+void join_pieces(TriangleMesh& mesh) {
+  std::map<std::array<double, 3>, std::uint32_t> first;
+  std::vector<std::uint32_t> to(mesh.vertices.size());
+  std::vector<Eigen::Vector3d> kept;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Eigen::Vector3d& p = mesh.vertices[v];
+    const auto [it, fresh] = first.try_emplace({p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(kept.size()));
+    if (fresh) kept.push_back(p);
+    to[v] = it->second;
+  }
+  for (auto& t : mesh.triangles) t = {to[t[0]], to[t[1]], to[t[2]]};
+  mesh.repairs.joined_objects = mesh.pieces.size();
+  mesh.vertices = std::move(kept);
+  mesh.pieces.assign(1, {});
+  for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) mesh.pieces.front().push_back(v);
+}
+
 // Drops degenerate and duplicate triangles; counts open and non-manifold edges; winds the
 // triangles outwards.
 void repair(TriangleMesh& mesh) {
@@ -212,6 +264,9 @@ double farthest_outside(const TriangleMesh& mesh, const std::vector<std::uint32_
 
 std::string TriangleMesh::Repairs::describe() const {
   std::vector<std::string> said;
+  if (joined_objects > 0) {
+    said.push_back(std::to_string(joined_objects) + " objects that are not convex pieces joined into one");
+  }
   const auto say = [&](std::size_t n, const std::string& one, const std::string& many) {
     if (n > 0) said.push_back(std::to_string(n) + " " + (n == 1 ? one : many));
   };
@@ -240,6 +295,7 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   auto mesh = std::make_shared<TriangleMesh>();
   append_node(*scene, *scene->mRootNode, aiMatrix4x4(), *mesh);
   if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds no triangles");
+  if (mesh->pieces.size() > 1 && !convex_pieces(*mesh)) join_pieces(*mesh);
   if (scale != 1) {
     for (auto& v : mesh->vertices) v *= scale;
     mesh->bounds = Eigen::AlignedBox3d(mesh->bounds.min() * scale, mesh->bounds.max() * scale);

@@ -48,9 +48,14 @@ struct TriangleMesh {
   // triangles wound against their neighbours, or a closed piece wound inside out, are turned
   // to face outwards (flipped); edges with one triangle (open) or more than two
   // (non-manifold) are counted.
+  // A file's objects are taken as the convex pieces of a decomposition only where every one
+  // of them closes a convex solid; where not (a CAD export that writes a face or a body per
+  // object), the objects are joined into one piece, welded where their corners coincide, and
+  // `joined_objects` says how many there were.
   struct Repairs {
     std::size_t degenerate = 0, duplicate = 0, flipped = 0, open_edges = 0, non_manifold_edges = 0;
-    bool any() const { return degenerate + duplicate + flipped + open_edges + non_manifold_edges > 0; }
+    std::size_t joined_objects = 0;
+    bool any() const { return degenerate + duplicate + flipped + open_edges + non_manifold_edges + joined_objects > 0; }
     std::string describe() const;  // "dropped 3 degenerate triangles; 12 open edges", or ""
   } repairs;
 };

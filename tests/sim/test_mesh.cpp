@@ -243,3 +243,20 @@ TEST_CASE("how far points lie outside a hull: beyond a face, an edge, a corner; 
   CHECK(outside({1, 0.3, -0.2}) == 0);
   CHECK(sim::farthest_outside(m, cube, cube) == 0);
 }
+
+TEST_CASE("objects that are not convex pieces are joined into one piece, welded: a CAD export of a face per object",
+          "[mesh]") {
+  // The beam of tests/data/planning/beam-frame written with every face an object of its own,
+  // each with its own copies of the corners. Taken as convex pieces, each face would be a flat
+  // hull, and a part could pass through the beam between them.
+  const auto mesh = sim::load_mesh(data("planning/beam-frame/meshes/beam_faces.obj"), 0.001);
+  CHECK(mesh->pieces.size() == 1);
+  CHECK(mesh->repairs.joined_objects == 12);
+  CHECK(mesh->repairs.open_edges == 0);  // welded where the faces meet: closed
+  CHECK_FALSE(mesh->convex);
+  CHECK(sim::loading_report(*mesh).find("12 objects that are not convex pieces joined into one") != std::string::npos);
+  // An authored decomposition stays as it is.
+  const auto faceplate = sim::load_mesh(products("cranfield/meshes/faceplate.obj"), 1);
+  CHECK(faceplate->pieces.size() > 1);
+  CHECK(faceplate->repairs.joined_objects == 0);
+}
