@@ -184,11 +184,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
-              "setup_cost", "currency", "standby_twins", "twin_identities"});
+              "setup_cost", "currency", "standby_twins", "twin_identities", "fixtures"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
   read(file, root, "localhost_only", c.localhost_only);
+  read(file, root, "fixtures", c.fixtures);
   if (c.domain < 0 || c.domain > 232) throw ConfigError(where(file, root["domain"]) + ": domain must be 0..232");
   if (c.real_time_factor <= 0) throw ConfigError(where(file, root["real_time_factor"]) + ": must be above 0");
   if (c.liveliness_lease <= 0) throw ConfigError(where(file, root["liveliness_lease"]) + ": must be above 0");
@@ -379,6 +380,7 @@ std::vector<std::string> twin_order_args(const CellConfig& c, const std::string&
                                 "--path", path, "--wait", std::to_string(wait_s)};
   if (!state_dir.empty()) args.insert(args.end(), {"--state-dir", state_dir.string()});
   add_gripper(args, c.gripper);
+  if (c.fixtures) args.push_back("--fixtures");
   if (quote) {
     args.insert(args.end(), {"--quote", "--setup-cost", std::to_string(c.setup_cost), "--currency", c.currency});
     for (const auto& s : c.stations) args.insert(args.end(), {"--cost-per-hour", s.id + "=" + std::to_string(s.cost_per_hour)});

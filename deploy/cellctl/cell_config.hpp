@@ -73,6 +73,10 @@ struct CellConfig {
   // `gripper: {max_opening: 0.2, ...}`: the arms' gripper, one for the cell (a twin plans
   // with it before it knows which station it gets); services/node/gripper.hpp.
   fb::GripperGeometry gripper;
+  // `fixtures: true`: the station has a jig that holds a part standing on nothing yet (a
+  // subassembly built aside that would topple): plans that need one are complete, and say
+  // where (twin::PlannerOptions::fixtures). Default: none.
+  bool fixtures = false;
   // `state_dir:` the folder of the cell's database (relative to the file's folder); empty:
   // $XDG_STATE_HOME (or ~/.local/state)/agile-cell/domain-N.
   std::filesystem::path state_dir;

@@ -46,7 +46,7 @@ void add_plan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--suggest", options->suggest,
                   "Where the links leave the order open and some orders fail or leave less margin, write the product "
                   "again to this .aml with the precedences that settle it");
-  cmd->add_option("--cell", options->cell, "Plan with this cell's gripper (its deployment file, key gripper:)");
+  cmd->add_option("--cell", options->cell, "Plan for this cell: its gripper and whether it has fixtures (its deployment file, keys gripper: and fixtures:)");
   cmd->add_option("--prefer", options->prefer,
                   "What --sequence search looks for: the first feasible order, or the one with the largest least "
                   "insertion margin")
@@ -60,7 +60,11 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     twin::PlannerOptions planning;
     planning.objective = options->prefer == "margin" ? twin::Objective::margin : twin::Objective::feasible;
     planning.margin_threshold = options->margin_mm / 1000;
-    if (!options->cell.empty()) planning.gripper = read_cell_config(options->cell).gripper;
+    if (!options->cell.empty()) {
+      const CellConfig cell = read_cell_config(options->cell);
+      planning.gripper = cell.gripper;
+      planning.fixtures = cell.fixtures;
+    }
     sim::MeshCache meshes;
     const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
     twin::require_geometry(loaded);

@@ -35,8 +35,7 @@ void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostre
     table.add_row({std::to_string(i + 1), name, inserts ? "subassembly" : twin::short_type_name(part.type), step.trajectory.label,
                    step.trajectory.grasp.label + " (" + fixed(step.trajectory.grasp.opening * 1000, 1) + " mm)",
                    fixed(step.trajectory.path_length() * 1000, 1), margin_text(step, plan.margin_reach),
-                   std::to_string(step.failed.size() + 1),
-                   step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)"});
+                   std::to_string(step.failed.size() + 1), twin::step_result(step)});
   }
   table.print(out);
   if (plan.verification.run) {

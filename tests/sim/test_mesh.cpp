@@ -226,7 +226,7 @@ TEST_CASE("a coarse hull holds every corner of the mesh: a real CAD post with ro
   CHECK(sim::farthest_outside(*mesh, mesh->hull_corners[0], mesh->hull_corners[0]) == 0);
 }
 
-TEST_CASE("how far points lie outside a hull: beyond a face, an edge, a corner; inside and on it, 0", "[mesh]") {
+TEST_CASE("how far points lie outside a hull: beyond a face, an edge, a corner, and 0 inside or on it", "[mesh]") {
   sim::TriangleMesh m;
   for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
   const std::vector<std::uint32_t> cube{0, 1, 2, 3, 4, 5, 6, 7};

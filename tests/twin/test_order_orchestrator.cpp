@@ -233,11 +233,26 @@ TEST_CASE("orchestrator: virtual assembly in the order's own scene first, holdin
     const twin::Quat turned(pose[3], pose[4], pose[5], pose[6]);
     CHECK(turned.angularDistance(twin::Quat(planned.waypoints.front().gripper.linear())) < 1e-9);
   }
+  // The front plate stands only pressed on (its plan step holds it): connected before the
+  // arm lets go. Every other part is let go, then connected.
+  std::vector<std::string> arm;
+  for (const auto& s : out.order) {
+    if (s == "COMMAND grip" || s == "COMMAND release" || s == "COMMAND connect") arm.push_back(s.substr(8));
+  }
+  std::vector<std::string> expected;
+  for (const auto& step : cranfield.plan.steps) {
+    const std::vector<std::string> sequence =
+        step.hold ? std::vector<std::string>{"grip", "connect", "release"} : std::vector<std::string>{"grip", "release", "connect"};
+    expected.insert(expected.end(), sequence.begin(), sequence.end());
+  }
+  CHECK(cranfield.plan.steps.back().hold);
+  CHECK(arm == expected);
 }
 
 TEST_CASE("orchestrator: a subassembly is built aside, then gripped by its base and inserted whole, virtually and physically",
           "[twin][orchestration][subassembly]") {
-  const test::Planned nested(std::filesystem::path(TEST_DATA_DIR) / "planning/cranfield-subassembly/cranfield-subassembly.aml");
+  const test::Planned nested(std::filesystem::path(TEST_DATA_DIR) / "planning/cranfield-subassembly/cranfield-subassembly.aml",
+                             test::with_fixtures());
   const twin::Plan& plan = nested.plan;
   REQUIRE(plan.complete);
   REQUIRE(plan.subassemblies.size() == 1);
@@ -287,7 +302,8 @@ TEST_CASE("orchestrator: a subassembly is built aside, then gripped by its base 
 }
 
 TEST_CASE("orchestrator: a subassembly that finds no way in cell-sim fails the order, every try said", "[twin][orchestration][subassembly]") {
-  const test::Planned nested(std::filesystem::path(TEST_DATA_DIR) / "planning/cranfield-subassembly/cranfield-subassembly.aml");
+  const test::Planned nested(std::filesystem::path(TEST_DATA_DIR) / "planning/cranfield-subassembly/cranfield-subassembly.aml",
+                             test::with_fixtures());
   REQUIRE(nested.plan.complete);
   const auto unit = std::find_if(nested.plan.steps.begin(), nested.plan.steps.end(), [](const auto& s) { return !s.carried.empty(); });
   REQUIRE(unit != nested.plan.steps.end());

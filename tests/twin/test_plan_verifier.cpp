@@ -42,8 +42,16 @@ TEST_CASE("verification: a base beam lowered over posts that stand where it goes
   // ASAP's beam frame (tests/data/real): posts 12.7 mm square on tenons that go into the base
   // beam's mortises. Stood on the station first, they are where the base must come down.
   const auto product = test::load(real("asap-beam-frame/asap-beam-frame.aml"));
-  const twin::Verification bad =
-      twin::verify_plan(product, unchecked_plan(product, {"post_left", "post_right", "base", "beam_left", "beam_right"}));
+  const twin::Plan posts_first = unchecked_plan(product, {"post_left", "post_right", "base", "beam_left", "beam_right"});
+  // Under gravity the first post would already topple where it stands, on its tenon.
+  const twin::Verification toppling = twin::verify_plan(product, posts_first);
+  REQUIRE_FALSE(toppling.violations.empty());
+  CHECK(toppling.violations.front().step == 1);
+  CHECK(toppling.violations.front().falls.find("post_left: it would topple") == 0);
+  // Without gravity, the base's way down over the posts.
+  twin::VerifyOptions geometry_only;
+  geometry_only.stability = false;
+  const twin::Verification bad = twin::verify_plan(product, posts_first, geometry_only);
   CHECK_FALSE(bad.verified);
   REQUIRE_FALSE(bad.violations.empty());
   const twin::Violation& v = bad.violations.front();
@@ -67,7 +75,14 @@ TEST_CASE("verification: the search does not go on from a base lowered over its 
   // cause was the coarse hull of a CAD part, grown by 3e35 m (tests/sim/test_mesh.cpp).
   const auto product = test::load(real("asap-beam-frame/asap-beam-frame.aml"));
   twin::GivenSequencePlanner posts_first({"post_left", "post_right", "base", "beam_left", "beam_right"});
-  const twin::Plan plan = twin::plan_assembly(product, posts_first, *twin::make_path_planner("linear"));
+  // Under gravity the first post is refused already: it would topple on its tenon.
+  const twin::Plan toppling = twin::plan_assembly(product, posts_first, *twin::make_path_planner("linear"));
+  CHECK_FALSE(toppling.complete);
+  CHECK(toppling.steps.empty());
+  // Without gravity, the posts go in and the base is refused.
+  twin::PlannerOptions geometry_only;
+  geometry_only.stability = false;
+  const twin::Plan plan = twin::plan_assembly(product, posts_first, *twin::make_path_planner("linear"), geometry_only);
   CHECK_FALSE(plan.complete);
   REQUIRE(plan.steps.size() == 2);
   bool base_blocked = false;

@@ -23,7 +23,9 @@ std::string text_of(const std::filesystem::path& file) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-twin::Plan plan_of(const twin::LoadedProduct& loaded, twin::PlannerOptions options = {}) {
+// For a cell with fixtures: the nested Cranfield's subassembly stands on nothing built aside
+// (test::with_fixtures).
+twin::Plan plan_of(const twin::LoadedProduct& loaded, twin::PlannerOptions options = test::with_fixtures()) {
   twin::SearchSequencePlanner sequence;
   return twin::plan_assembly(loaded, sequence, *twin::make_path_planner("linear"), options);
 }
@@ -211,7 +213,7 @@ TEST_CASE("subassemblies: one that cannot be built on its own makes the plan inc
   // With the plates as one unit the shaft cannot go in between them, and the top level's
   // search would try every order (10,000 backtracks: 75 s, under ASan 8 minutes; 50: 25 s);
   // what is asked here is said by the subassembly's own planning, before the first.
-  twin::PlannerOptions bounded;
+  twin::PlannerOptions bounded = test::with_fixtures();
   bounded.max_backtracks = 1;
   const twin::Plan plan = plan_of(loaded, bounded);
   CHECK_FALSE(plan.complete);
@@ -272,7 +274,7 @@ TEST_CASE("subassemblies: precedences are suggested level by level, and written 
   const auto dir = std::filesystem::temp_directory_path() / ("subassembly-suggest-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto loaded = test::load(test::data(kNested));
-  twin::PlannerOptions options;
+  twin::PlannerOptions options = test::with_fixtures();
   options.max_backtracks = 20;  // an alternative that cannot go together is shown so soon enough
   twin::Plan plan = plan_of(loaded, options);
   REQUIRE(plan.complete);

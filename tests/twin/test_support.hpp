@@ -25,15 +25,25 @@ inline twin::LoadedProduct load(const std::filesystem::path& file) {
 // A product loaded and planned as the twin plans it (search, linear); the mesh cache lives
 // as long as the product that points into it.
 struct Planned {
-  explicit Planned(const std::filesystem::path& file) : product(twin::load_product(file, meshes)), plan(plan_of(product)) {}
-  static twin::Plan plan_of(const twin::LoadedProduct& product) {
+  explicit Planned(const std::filesystem::path& file, const twin::PlannerOptions& options = {})
+      : product(twin::load_product(file, meshes)), plan(plan_of(product, options)) {}
+  static twin::Plan plan_of(const twin::LoadedProduct& product, const twin::PlannerOptions& options = {}) {
     auto sequence = twin::make_sequence_planner("search");
-    return twin::plan_assembly(product, *sequence, *twin::make_path_planner("linear"));
+    return twin::plan_assembly(product, *sequence, *twin::make_path_planner("linear"), options);
   }
   sim::MeshCache meshes;
   twin::LoadedProduct product;
   twin::Plan plan;
 };
+
+// Planning for a cell with fixtures (deploy/cells/default.yaml): the nested Cranfield's shaft
+// and pendulum, built aside, stand on nothing (the pendulum's arm tips them over) until they
+// go in; the cell's jig holds them.
+inline twin::PlannerOptions with_fixtures() {
+  twin::PlannerOptions options;
+  options.fixtures = true;
+  return options;
+}
 
 inline const twin::DigitalPart& part(const twin::Product& product, const std::string& name) {
   const auto index = product.find_part_by_name(name);

@@ -16,12 +16,14 @@ struct ItemApplier {
     part.orientation = item.orientation;
     part.mesh = item.mesh;
     part.own_interfaces = item.interfaces;
+    part.own_joints = item.joints;
     part.subassembly = item.subassembly;
     part.where = item.where;
     product.add_part(std::move(part));
   }
   void operator()(const ParameterItem& item) const {
     product.set_type_interface(item.type, item.interface, item.frame);
+    if (item.joint) product.set_type_joint(item.type, item.interface, *item.joint);
   }
   void operator()(const ConnectionItem&) const {}
   void operator()(const PrecedenceItem&) const {}

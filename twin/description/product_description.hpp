@@ -24,6 +24,7 @@ struct CreatePartItem {
   Quat orientation = Quat::Identity();
   std::optional<MeshRef> mesh;
   InterfaceMap interfaces;  // declared on the instance itself
+  JointMap joints;          // the joints its own interfaces declare
   std::string subassembly;  // the subassembly it belongs to; empty when it goes in alone
   SourceRef where;
 };
@@ -33,6 +34,7 @@ struct ParameterItem {
   std::string type;
   std::string interface;
   std::optional<Frame> frame;  // empty: declared without coordinates
+  std::optional<Joint> joint;  // the joint it declares, if any
   SourceRef where;
 };
 

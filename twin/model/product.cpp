@@ -12,6 +12,21 @@ void Product::set_type_interface(const std::string& type, const std::string& int
   t.interfaces[interface] = frame;
 }
 
+void Product::set_type_joint(const std::string& type, const std::string& interface, const Joint& joint) {
+  PartType& t = types_[type];
+  t.name = type;
+  t.joints[interface] = joint;
+}
+
+const Joint* Product::joint_of(PartIndex part, const std::string& interface) const {
+  const DigitalPart& p = parts_.at(part);
+  if (const auto it = p.own_joints.find(interface); it != p.own_joints.end()) return &it->second;
+  const auto type = types_.find(p.type);
+  if (type == types_.end()) return nullptr;
+  const auto it = type->second.joints.find(interface);
+  return it == type->second.joints.end() ? nullptr : &it->second;
+}
+
 PartIndex Product::add_part(DigitalPart part) {
   if (auto existing = find_part(part.id)) {
     throw DescriptionError(part.where, "duplicate ID '" + part.id + "': part '" +
@@ -75,10 +90,19 @@ void Product::connect(const std::string& part_a, const std::string& interface_a,
     return *index;
   };
   Connection c{resolve(part_a, interface_a), interface_a, resolve(part_b, interface_b),
-               interface_b, name, where};
+               interface_b, name, where, {}};
   if (c.part1 == c.part2) {
     throw DescriptionError(where, "link joins part '" + parts_[c.part1].name + "' to itself");
   }
+  // The joint: what either side declares; two that differ are a contradiction.
+  const Joint* a = joint_of(c.part1, interface_a);
+  const Joint* b = joint_of(c.part2, interface_b);
+  if (a && b && (a->kind != b->kind || a->pitch != b->pitch)) {
+    throw DescriptionError(where, "link '" + name + "' joins interfaces that declare different joints: " +
+                                      joint_name(a->kind) + " (" + a->where.to_string() + ") and " + joint_name(b->kind) +
+                                      " (" + b->where.to_string() + ")");
+  }
+  if (a || b) c.joint = a ? *a : *b;
   by_part_[c.part1].push_back(connections_.size());
   by_part_[c.part2].push_back(connections_.size());
   connections_.push_back(std::move(c));

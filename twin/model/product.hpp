@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "twin/model/frame.hpp"
+#include "twin/model/joint.hpp"
 #include "twin/model/source_ref.hpp"
 
 namespace twin {
@@ -20,12 +21,15 @@ using PartIndex = std::size_t;
 
 // Declared interfaces by name; an empty optional is an interface without coordinates.
 using InterfaceMap = std::map<std::string, std::optional<Frame>>;
+// The joints interfaces declare (docs/automationml.md, "Joints"), by interface name.
+using JointMap = std::map<std::string, Joint>;
 
 // A part type (an AutomationML SystemUnitClass): the paper's 3D parameters, held per
 // product instead of in a static HashMap.
 struct PartType {
   std::string name;
   InterfaceMap interfaces;
+  JointMap joints;
 };
 
 struct MeshRef {
@@ -43,6 +47,7 @@ struct DigitalPart {
   Quat orientation = Quat::Identity();  // in the finished product
   std::optional<MeshRef> mesh;
   InterfaceMap own_interfaces;  // declared on the instance; override the type's
+  JointMap own_joints;          // likewise
   // The subassembly it belongs to (docs/automationml.md): built first with the other parts of
   // that name, then inserted with them as one rigid body. Empty: it goes in alone.
   std::string subassembly;
@@ -58,6 +63,7 @@ struct Connection {
   std::string interface2;
   std::string name;
   SourceRef where;
+  Joint joint;  // what either side's interface declares; contact where neither does
 };
 
 class Product {
@@ -74,6 +80,7 @@ class Product {
   // Mutators check what they can at once and throw DescriptionError naming `where`.
   void set_type_interface(const std::string& type, const std::string& interface,
                           const std::optional<Frame>& frame);
+  void set_type_joint(const std::string& type, const std::string& interface, const Joint& joint);
   PartIndex add_part(DigitalPart part);
   void connect(const std::string& part_a, const std::string& interface_a, const std::string& part_b,
                const std::string& interface_b, const std::string& name, const SourceRef& where);
@@ -91,6 +98,8 @@ class Product {
   // The paper's getConnectionPoint: the interface in its part's frame, the instance's own
   // declaration first, then its type's. nullptr when the part declares no such interface.
   const std::optional<Frame>* interface_of(PartIndex part, const std::string& interface) const;
+  // The joint an interface declares, the instance's first; nothing where it declares none.
+  const Joint* joint_of(PartIndex part, const std::string& interface) const;
   // Connections that touch a part, by index into connections().
   const std::vector<std::size_t>& connections_of(PartIndex part) const { return by_part_[part]; }
 

@@ -711,13 +711,19 @@ void OrderOrchestrator::back_to_sequence_planning() {
 }
 
 // After the grip: move along the gripper's poses while holding, release, back out, connect.
+// A step that holds its part (PlanStep::hold: it stands only once fastened) connects before
+// the release, the gripper still on the part.
 void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, const std::vector<Pose>& holding,
-                                      const std::vector<Pose>& retreat, const std::string& aside) {
+                                      const std::vector<Pose>& retreat, const std::string& aside, bool hold) {
   const bool turns = std::any_of(holding.begin(), holding.end(),
                                  [&](const Pose& p) { return !p.linear().isApprox(holding.front().linear(), 1e-9); });
   Data move = command(arm_, turns ? "rotate" : "translate", bodies.front());
   move["path"] = pose_numbers(holding);
   actions_.push_back({Action::command, move});
+  const auto connect = [&] {
+    for (const auto& body : bodies) actions_.push_back({Action::command, command(arm_, "connect", body)});
+  };
+  if (hold) connect();
   Data release = command(arm_, "release", bodies.front());
   // The state records where the parts go with the release (CellStore::release).
   release["destination"] = aside.empty() ? std::string("product") : "aside:" + aside;
@@ -726,7 +732,7 @@ void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, co
   Data back = command(arm_, "translate", bodies.front());
   back["path"] = pose_numbers(retreat);
   actions_.push_back({Action::command, back});
-  for (const auto& body : bodies) actions_.push_back({Action::command, command(arm_, "connect", body)});
+  if (!hold) connect();
 }
 
 namespace {
@@ -846,7 +852,7 @@ void OrderOrchestrator::plan_physical() {
     take["carried"] = fb::join_names({moved.begin() + 1, moved.end()});
     actions_.push_back({Action::command, take});
     const auto [holding, retreat] = carry(station_, steps[k], t, standing);
-    add_arm_moves(moved, holding, retreat, unit && !inserts_unit(step) ? unit->name : "");
+    add_arm_moves(moved, holding, retreat, unit && !inserts_unit(step) ? unit->name : "", step.hold);
   }
   next_action();
 }

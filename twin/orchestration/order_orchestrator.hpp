@@ -158,9 +158,9 @@ class OrderOrchestrator : public fb::BasicBlock {
   void plan_cleanup();
   void add_unit_candidate(std::size_t step, const Trajectory& t);
   // `bodies`: the gripped one first, then those it carries; `aside`: the subassembly they are
-  // built into aside, "" when they go into the product.
+  // built into aside, "" when they go into the product; `hold`: connected before the release.
   void add_arm_moves(const std::vector<std::string>& bodies, const std::vector<Pose>& holding,
-                     const std::vector<Pose>& retreat, const std::string& aside);
+                     const std::vector<Pose>& retreat, const std::string& aside, bool hold);
   fb::Data command(const std::string& resource, const std::string& operation, const std::string& part = "");
   // Running them.
   void next_action();

@@ -68,6 +68,7 @@ struct Options {
   std::string order, product, out = ".", sequence = "search", path = "linear", state_dir;
   double wait_s = 30, lease_s = 5;
   fb::GripperGeometry gripper;
+  bool fixtures = false;  // the cell holds what stands on nothing yet (PlannerOptions::fixtures)
   bool verbose = false;
   bool quiet = false;
   bool quote = false;
@@ -136,6 +137,7 @@ class TwinProcess {
     auto path = twin::make_path_planner(options_.path);
     twin::PlannerOptions planning;
     planning.gripper = options_.gripper;
+    planning.fixtures = options_.fixtures;
     twin::Plan plan = plan_order(product, *path, planning);
     std::filesystem::create_directories(options_.out);
     const auto plan_file = std::filesystem::absolute(options_.out) / "plan.json";
@@ -477,6 +479,8 @@ void add_order_options(CLI::App& app, Options& o, std::vector<std::string>& rate
   app.add_option("--wait", o.wait_s, "How long to wait for the cell's resources, s")->check(CLI::PositiveNumber);
   dds::add_state_option(app, o.state_dir);
   dds::add_gripper_options(app, o.gripper);
+  app.add_flag("--fixtures", o.fixtures,
+               "The cell has fixtures: a plan that needs one to hold a part that stands on nothing yet is complete");
   app.add_flag("--quote", o.quote, "Assemble virtually only and answer with quote.json: time and cost here, findings");
   app.add_option("--setup-cost", o.rates.setup_cost, "Quote: the fixed cost of an order")->check(CLI::NonNegativeNumber);
   app.add_option("--cost-per-hour", rates, "Quote: RESOURCE=COST, for each hour the order uses the resource");

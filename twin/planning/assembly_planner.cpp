@@ -30,9 +30,14 @@ std::string join(const std::vector<std::string>& names, const std::string& separ
 
 class Search {
  public:
-  Search(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path, const PlannerOptions& options)
+  Search(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path, const PlannerOptions& options,
+         const StabilityAnalysis* stability)
       : product_(product), sequence_(sequence), path_(path), options_(options),
-        scene_(product, options.collision, options.gripper), assembled_(product.product.parts().size(), false) {}
+        scene_(product, options.collision, options.gripper), assembled_(product.product.parts().size(), false),
+        stability_(options.stability ? stability : nullptr) {}
+
+  // Whether the search put a part aside because it would not stand where it went.
+  bool refused_for_gravity() const { return !falls_.empty(); }
 
   Plan run() {
     plan_.sequence_planner = sequence_.name();
@@ -94,7 +99,13 @@ class Search {
         if (!sequence_.backtracks()) return give_up(part);
         continue;
       }
-      PlanStep step{part, std::move(*trajectory), std::move(tried), allowed, "", {}, std::nullopt, false};
+      const Standing standing = stands_with(part);
+      if (standing.falls) {
+        falls_[part] = *standing.falls;
+        if (!sequence_.backtracks()) return give_up(part);
+        continue;
+      }
+      PlanStep step{part, std::move(*trajectory), std::move(tried), allowed, "", {}, std::nullopt, false, standing.hold};
       if (options_.objective == Objective::margin) {
         measure(step);
         // No order through this step beats the best found: its least margin is at most this.
@@ -125,6 +136,42 @@ class Search {
   }
 
   double margin_of(const PlanStep& step) const { return step.margin ? step.margin->distance : options_.margin_reach; }
+
+  struct Standing {
+    std::optional<Instability> falls;  // what would move
+    bool hold = false;                 // stands only once the part's fastening is made
+  };
+
+  // Whether the parts in place stand with `part` put in, its fastenings to them made; and
+  // whether it needs the arm until they are (it would not stand released before). Known
+  // states are not asked again.
+  Standing stands_with(PartIndex part) {
+    if (!stability_) return {};
+    std::vector<bool> key = assembled_;
+    key.push_back(false);
+    key[part] = true;
+    if (const auto known = standing_.find(key); known != standing_.end()) return known->second;
+    std::vector<PlacedPart> placed;
+    for (PartIndex p = 0; p < assembled_.size(); ++p) {
+      if (assembled_[p] || p == part) placed.push_back({p, product_.product.parts()[p].final_pose});
+    }
+    const auto& connections = product_.product.connections();
+    std::vector<bool> fastened(connections.size(), false), before;
+    for (std::size_t c = 0; c < connections.size(); ++c) {
+      const auto in = [&](PartIndex p) { return assembled_[p] || p == part; };
+      fastened[c] = connections[c].joint.fastens() && in(connections[c].part1) && in(connections[c].part2);
+    }
+    Standing out;
+    out.falls = stability_->check(placed, {}, fastened, part);
+    before = fastened;
+    bool fastens = false;
+    for (std::size_t c : product_.product.connections_of(part)) {
+      fastens = fastens || before[c];
+      before[c] = false;
+    }
+    if (!out.falls && fastens) out.hold = stability_->check(placed, {}, before, part).has_value();
+    return standing_[key] = out;
+  }
 
   bool too_large_to_measure(PartIndex part) const {
     return scene_.exact_triangles(part) > options_.margin_max_triangles;
@@ -198,6 +245,9 @@ class Search {
 
   // Why a part is not in the plan, as far as the search knows.
   std::string why_not(PartIndex p) {
+    if (const auto fell = falls_.find(p); fell != falls_.end() && !unplaceable_.count(p)) {
+      return "it would not stand where it goes: " + describe(product_.product, fell->second, options_.stand);
+    }
     if (unplaceable_.count(p)) {
       const auto& blockers = blocked_by_[p];
       std::vector<std::string> why;
@@ -350,6 +400,9 @@ class Search {
   std::set<PartIndex> first_backtracked_;
   bool stopped_ = false;
   std::optional<std::pair<PartIndex, std::size_t>> stopped_at_;  // the part and step a sequence ended at
+  const StabilityAnalysis* stability_;
+  std::map<std::vector<bool>, Standing> standing_;  // by the parts in place, the new one among them
+  std::map<PartIndex, Instability> falls_;          // the last group each part would have made fall
 };
 
 }  // namespace
@@ -360,6 +413,11 @@ std::string step_name(const Product& product, const PlanStep& step) {
   std::vector<std::string> members{part};
   for (PartIndex p : step.carried) members.push_back(product.parts()[p].name);
   return step.subassembly + " (" + join(members) + ")";
+}
+
+std::string step_result(const PlanStep& step) {
+  std::string out = step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)";
+  return step.hold ? out + ", held until fastened" : out;
 }
 
 double least_margin(const std::vector<PlanStep>& steps, double reach) {
@@ -374,11 +432,14 @@ namespace {
 
 // The plan replayed on its own (plan_verifier.hpp): a step that fails it makes the plan
 // incomplete, with a finding that says what went how deep into what.
-void verify(const LoadedProduct& product, Plan& plan, const PlannerOptions& options) {
+void verify(const LoadedProduct& product, Plan& plan, const PlannerOptions& options, const StabilityAnalysis& stability) {
   VerifyOptions check;
+  check.analysis = &stability;
   check.contact_tolerance = options.collision.contact_tolerance;
   check.resolution = options.verify_resolution;
   check.gripper = options.gripper;
+  check.stability = options.stability;
+  check.stand = options.stand;
   const auto start = std::chrono::steady_clock::now();
   const Verification v = verify_plan(product, plan, check);
   plan.verification.run = true;
@@ -387,24 +448,67 @@ void verify(const LoadedProduct& product, Plan& plan, const PlannerOptions& opti
   plan.verification.sweeps = v.sweeps;
   plan.verification.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (const Violation& violation : v.violations) {
-    plan.findings.push_back({"verification", describe(product.product, violation) + ": the step cannot be built as planned",
-                             {product.product.parts()[plan.steps[violation.step - 1].part].name, violation.with}});
+    std::vector<std::string> parts{product.product.parts()[plan.steps[violation.step - 1].part].name};
+    if (!violation.with.empty()) parts.push_back(violation.with);
+    plan.findings.push_back({"verification", describe(product.product, violation) + ": the step cannot be built as planned", parts});
   }
   if (!v.violations.empty()) plan.complete = false;
+}
+
+// Where no order stands, the order that goes together without gravity, with the steps after
+// which something would fall named: a fixture must hold it. Complete only for a cell that has
+// fixtures (PlannerOptions::fixtures).
+std::optional<Plan> plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
+                                       const PlannerOptions& options, const StabilityAnalysis& stability) {
+  PlannerOptions loose = options;
+  loose.stability = false;
+  Plan plan = Search(product, sequence, path, loose, nullptr).run();
+  if (!plan.complete) return std::nullopt;
+  const auto& connections = product.product.connections();
+  std::vector<PlacedPart> placed;
+  std::vector<PartIndex> held;  // by fixtures, from the step that needs them on
+  std::vector<bool> in(product.product.parts().size(), false);
+  for (std::size_t i = 0; i < plan.steps.size(); ++i) {
+    const PartIndex part = plan.steps[i].part;
+    in[part] = true;
+    placed.push_back({part, product.product.parts()[part].final_pose});
+    std::vector<bool> fastened(connections.size());
+    for (std::size_t c = 0; c < connections.size(); ++c) {
+      fastened[c] = connections[c].joint.fastens() && in[connections[c].part1] && in[connections[c].part2];
+    }
+    if (const auto falls = stability.check(placed, held, fastened)) {
+      plan.steps[i].fixture = falls->parts;
+      held.insert(held.end(), falls->parts.begin(), falls->parts.end());
+      plan.findings.push_back({"fixture",
+                               "step " + std::to_string(i + 1) + " (" + product.product.parts()[part].name +
+                                   "): a fixture must hold " + describe(product.product, *falls, options.stand),
+                               {product.product.parts()[part].name}});
+    }
+  }
+  plan.stability = options.stability;
+  plan.complete = options.fixtures;
+  return plan;
 }
 
 }  // namespace
 
 Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
                    const PlannerOptions& options) {
+  // One analysis for the search and the replay: contacts between parts are found once.
+  const StabilityAnalysis stability(product, options.stand);
   Plan plan;
   if (!subassemblies_of(product.product).empty()) {
     if (!options.given.empty()) throw std::logic_error("planning on from given steps of a product with subassemblies");
     plan = plan_with_subassemblies(product, sequence, path, options);
   } else {
-    plan = Search(product, sequence, path, options).run();
+    Search search(product, sequence, path, options, &stability);
+    plan = search.run();
+    if (!plan.complete && search.refused_for_gravity()) {
+      if (auto fixtures = plan_with_fixtures(product, sequence, path, options, stability)) plan = std::move(*fixtures);
+    }
   }
-  if (options.verify) verify(product, plan, options);
+  plan.stability = options.stability;
+  if (options.verify) verify(product, plan, options, stability);
   return plan;
 }
 

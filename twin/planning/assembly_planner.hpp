@@ -12,6 +12,7 @@
 
 #include "twin/planning/path_planner.hpp"
 #include "twin/planning/sequence_planner.hpp"
+#include "twin/planning/stability.hpp"
 
 namespace twin {
 
@@ -29,6 +30,11 @@ struct PlanStep {
   // The least room on the way in (AssemblyScene::margin); nothing: more than the reach.
   std::optional<Margin> margin;
   bool margin_measured = false;
+  // The arm keeps the part until the cell has made its fastening (a screw turned, a press fit
+  // pressed home) and lets go after: released before, it would not stand.
+  bool hold = false;
+  // Parts a fixture holds from this step on, where no order stands (PlannerOptions::fixtures).
+  std::vector<PartIndex> fixture;
 };
 
 struct SubassemblyPlan {
@@ -64,6 +70,7 @@ struct Plan {
   std::vector<SubassemblyPlan> subassemblies;  // each one's steps come before the step inserting it
   double margin_threshold = 0, margin_reach = 0;  // m, as planned with (PlannerOptions)
   PlanVerification verification;
+  bool stability = false;  // every state asked whether it stands (PlannerOptions::stability)
 };
 
 // What a search that goes back looks for among the orders the links allow.
@@ -92,6 +99,13 @@ struct PlannerOptions {
   // (plan_verifier.hpp); `verify_resolution`: its VerifyOptions::resolution.
   bool verify = true;
   double verify_resolution = 1.5e-4;
+  // Every state after a step must stand under gravity (stability.hpp); a part that would not
+  // is not put in there, and the search looks for an order that puts supports first.
+  bool stability = true;
+  StabilityOptions stand;
+  // The cell can hold a part that stands on nothing yet in a fixture: where no order stands,
+  // such a plan is complete with 'fixture' findings; without, it is not.
+  bool fixtures = false;
 };
 
 // Margins closer than this are taken as equal, m: Objective::margin takes an order as better
@@ -105,6 +119,9 @@ double least_margin(const std::vector<PlanStep>& steps, double reach);
 // What a step puts in: the part's name, or for a subassembly's insertion its name and its
 // parts' ("ShaftPendulum (shaft, pendulum)").
 std::string step_name(const Product& product, const PlanStep& step);
+
+// How a step went, for tables: "ok", "ok after 2 collision(s)", "... , held until fastened".
+std::string step_result(const PlanStep& step);
 
 // A product with subassemblies is planned in a hierarchy (subassembly_planner.hpp); `given`
 // steps are for a product without.

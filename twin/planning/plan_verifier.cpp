@@ -322,6 +322,8 @@ class Replay {
  public:
   Replay(const LoadedProduct& product, const Plan& plan, const VerifyOptions& options)
       : product_(product), plan_(plan), options_(options) {
+    if (options.stability && !options.analysis) own_stability_.emplace(product, options.stand);
+    stability_ = options.analysis ? options.analysis : own_stability_ ? &*own_stability_ : nullptr;
     // The station: a slab whose top is the assembly surface, as planning has it.
     Pose slab = Pose::Identity();
     slab.translation() = Vec3(0, -0.025, 0);
@@ -332,7 +334,9 @@ class Replay {
   Verification run() {
     placed_.assign(product_.product.parts().size(), std::nullopt);
     for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
-      if (auto violation = replay(plan_.steps[i])) {
+      auto violation = replay(plan_.steps[i]);
+      if (!violation) violation = falls_after(plan_.steps[i]);
+      if (violation) {
         violation->step = i + 1;
         result_.violations.push_back(*violation);
       }
@@ -430,6 +434,31 @@ class Replay {
       for (const auto& [p, offset] : carried) placed_[p] = w.back().part * offset;
     }
     return found;
+  }
+
+  // Whether the parts in place stand once the arm has let go of the step's part: its
+  // fastenings made if the step holds it until they are, else not yet.
+  std::optional<Violation> falls_after(const PlanStep& step) {
+    if (!stability_) return std::nullopt;
+    const auto& connections = product_.product.connections();
+    std::vector<PlacedPart> placed;
+    for (PartIndex p = 0; p < placed_.size(); ++p) {
+      if (placed_[p]) placed.push_back({p, *placed_[p]});
+    }
+    std::vector<bool> fastened(connections.size(), false);
+    for (std::size_t c = 0; c < connections.size(); ++c) {
+      const Connection& k = connections[c];
+      fastened[c] = k.joint.fastens() && placed_[k.part1] && placed_[k.part2];
+      if (!step.hold && (k.part1 == step.part || k.part2 == step.part)) fastened[c] = false;
+    }
+    held_.insert(held_.end(), step.fixture.begin(), step.fixture.end());  // the plan's fixtures hold these
+    const auto falls = stability_->check(placed, held_, fastened);
+    if (!falls) return std::nullopt;
+    Violation v;
+    v.phase = "release";
+    v.member = product_.product.parts()[step.part].name;
+    v.falls = describe(product_.product, *falls, options_.stand);
+    return v;
   }
 
   // The first member at `pose` that goes into an obstacle past the tolerance, how deep.
@@ -628,12 +657,16 @@ class Replay {
   std::map<double, Gripper> grippers_;
   std::vector<std::optional<Pose>> placed_;
   std::vector<std::size_t> near_, against_;  // kept between calls: no allocation per query
+  std::optional<StabilityAnalysis> own_stability_;
+  const StabilityAnalysis* stability_ = nullptr;
+  std::vector<PartIndex> held_;  // by the plan's fixtures
 };
 
 }  // namespace
 
 std::string describe(const Product& product, const Violation& v) {
   (void)product;
+  if (!v.falls.empty()) return "step " + std::to_string(v.step) + ": when the arm lets go, " + v.falls;
   char depth[32];
   std::snprintf(depth, sizeof depth, "%.2f mm", v.depth * 1000);
   const bool part = v.member != "finger" && v.member != "palm" && v.member != "carriage";

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "twin/planning/assembly_planner.hpp"
+#include "twin/planning/stability.hpp"
 
 namespace twin {
 
@@ -23,6 +24,13 @@ struct VerifyOptions {
   // than contact_tolerance + 2 x resolution is found; every depth reported is real.
   double resolution = 1.5e-4;
   fb::GripperGeometry gripper;
+  // After each step the parts in place must stand (stability.hpp): as the arm leaves them, its
+  // part's fastenings not yet made unless the step holds it until they are.
+  bool stability = true;
+  StabilityOptions stand;
+  // The analysis to ask (its contacts and the states it has answered are facts of the
+  // product, whoever asked first: the planner shares its own); null: one of the replay's own.
+  const StabilityAnalysis* analysis = nullptr;
 };
 
 struct Violation {
@@ -32,6 +40,7 @@ struct Violation {
   std::string with;      // what it went into: a part's name or "station"
   double depth = 0;      // m, the deepest point found
   Vec3 where = Vec3::Zero();  // that point, in the product's frame
+  std::string falls;          // or, after the step, what would not stand (stability.hpp's describe)
 };
 
 struct Verification {
@@ -41,7 +50,8 @@ struct Verification {
   std::size_t sweeps = 0;  // straight moves checked whole
 };
 
-// "step 3 (base): the part went 3.85 mm into post_left while insert"
+// "step 3: the base went 3.85 mm into post_left while insert",
+// "step 2: when the arm lets go, post_left: it would topple ..."
 std::string describe(const Product& product, const Violation& violation);
 
 // Replays the plan's steps in order. A step's part (a subassembly's insertion: its base and the

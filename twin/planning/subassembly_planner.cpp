@@ -14,6 +14,7 @@ Product empty_like(const Product& product, const std::string& name) {
   Product out(name, product.source());
   for (const auto& [type, part_type] : product.types()) {
     for (const auto& [interface, frame] : part_type.interfaces) out.set_type_interface(type, interface, frame);
+    for (const auto& [interface, joint] : part_type.joints) out.set_type_joint(type, interface, joint);
   }
   return out;
 }
@@ -239,6 +240,7 @@ Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequ
     Plan own = plan_assembly(level.product, sequence, path, each);
     for (PlanStep step : own.steps) {
       step.allowed = mapped(step.allowed, level.origin);
+      step.fixture = mapped(step.fixture, level.origin);
       if (!level.subassembly.empty()) {
         step.subassembly = level.subassembly;
       } else if (const int u = level.unit[step.part]; u >= 0) {

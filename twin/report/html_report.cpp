@@ -71,8 +71,7 @@ void steps_table(std::ostream& html, const Product& product, const Plan& plan) {
          << escape(step.trajectory.label) << "</td><td>" << escape(step.trajectory.grasp.label) << " ("
          << fixed(step.trajectory.grasp.opening * 1000, 1) << " mm)</td><td>" << fixed(step.trajectory.path_length() * 1000, 1)
          << "</td>" << margin_cell(step, plan) << "<td>" << step.failed.size() + 1 << "</td><td>"
-         << (step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)")
-         << "</td></tr>\n";
+         << escape(step_result(step)) << "</td></tr>\n";
   }
   html << "</tbody></table>\n";
 }

@@ -99,7 +99,7 @@ pugi::xml_node CaexWriter::unit_class(const std::string& name, const std::string
 }
 
 void CaexWriter::interface_point(pugi::xml_node unit_class, const std::string& name,
-                                 const std::string& interface_class, const Eigen::Vector3d& mm) {
+                                 const std::string& interface_class, const Eigen::Vector3d& mm, const std::string& joint) {
   pugi::xml_node a = add_attribute(unit_class, name,
                                    format_mm(mm.x()) + "," + format_mm(mm.y()) + "," + format_mm(mm.z()),
                                    "DefaultValue");
@@ -108,6 +108,12 @@ void CaexWriter::interface_point(pugi::xml_node unit_class, const std::string& n
   i.append_attribute("Name") = name.c_str();
   i.append_attribute("RefBaseClassPath") = (interface_lib_name_ + "/" + interface_class).c_str();
   i.append_attribute("ID") = stable_uuid(std::string(unit_class.attribute("Name").value()) + "/" + name).c_str();
+  if (!joint.empty()) {
+    pugi::xml_node j = i.append_child("Attribute");
+    j.append_attribute("Name") = "Joint";
+    j.append_attribute("AttributeDataType") = "xs:string";
+    j.append_child("Value").text() = joint.c_str();
+  }
 }
 
 void CaexWriter::geometry(pugi::xml_node unit_class, const std::string& ref_uri) {

@@ -17,9 +17,10 @@ class CaexWriter {
   void interface_class(const std::string& name);
   // A SystemUnitClass in the product's class library; `base` is another class's name.
   pugi::xml_node unit_class(const std::string& name, const std::string& base = "");
-  // An interface point, in mm, on a class.
+  // An interface point, in mm, on a class; `joint`: the joint it declares (docs/automationml.md,
+  // "Joints"), none where empty.
   void interface_point(pugi::xml_node unit_class, const std::string& name,
-                       const std::string& interface_class, const Eigen::Vector3d& mm);
+                       const std::string& interface_class, const Eigen::Vector3d& mm, const std::string& joint = "");
   // A mesh file (relative path) for every part of a class.
   void geometry(pugi::xml_node unit_class, const std::string& ref_uri);
 

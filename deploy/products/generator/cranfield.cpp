@@ -73,7 +73,8 @@ void write_cranfield(const std::filesystem::path& dir) {
   for (const auto& h : kHoles) {
     const char* iclass = h.square ? "IBoltAngular" : (std::string(h.name) == "shaft" ? "IShaft" : "IBolt");
     aml.interface_point(back, h.name, iclass, V(h.x, 0, h.z));                 // bottom face, as in the paper
-    aml.interface_point(front, h.name, iclass, V(h.x, kPlateThickness, h.z));  // top face
+    // The front plate is pressed onto the pegs and the shaft: nothing else holds it up.
+    aml.interface_point(front, h.name, iclass, V(h.x, kPlateThickness, h.z), "press-fit");  // top face
   }
 
   pugi::xml_node peg = aml.unit_class("Peg");

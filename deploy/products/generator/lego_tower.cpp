@@ -87,8 +87,9 @@ void write_lego_tower(const std::filesystem::path& dir) {
       for (int j = 0; j < sz; ++j) {
         const Eigen::Vector2d p = stud_local(sx, sz, i, j);
         const std::string stud = std::to_string(i) + "_" + std::to_string(j);
-        aml.interface_point(c, "top_" + stud, "IStud", Eigen::Vector3d(p.x(), kHeight, p.y()));
-        aml.interface_point(c, "bottom_" + stud, "IAntiStud", Eigen::Vector3d(p.x(), 0, p.y()));
+        // Studs clutch: a brick pressed onto another holds to it (the meshes have no studs).
+        aml.interface_point(c, "top_" + stud, "IStud", Eigen::Vector3d(p.x(), kHeight, p.y()), "studs");
+        aml.interface_point(c, "bottom_" + stud, "IAntiStud", Eigen::Vector3d(p.x(), 0, p.y()), "studs");
       }
     }
   }

@@ -1,6 +1,8 @@
 #include "twin/description/automationml/automationml_description.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <cctype>
 #include <map>
 #include <set>
@@ -247,6 +249,7 @@ class CaexReader {
       std::optional<Frame> frame;
       if (const auto f = frame_attribute(i)) frame = aml::parse_frame(f, file_);
       part.interfaces[name] = frame;
+      if (const auto joint = joint_of(i)) part.joints[name] = *joint;
     });
     // An instance Attribute named like an interface moves that interface for this part.
     for (const auto& [name, attribute] : own_attributes) {
@@ -274,6 +277,45 @@ class CaexReader {
   static bool has_value(const pugi::xml_node& attribute) {
     const auto text = aml::attribute_text(attribute);
     return text && !text->empty();
+  }
+
+  // The joint an ExternalInterface declares (docs/automationml.md, "Joints"): an Attribute
+  // "Joint" naming its kind, and for a screw "Pitch", a length per turn.
+  std::optional<Joint> joint_of(const pugi::xml_node& interface) const {
+    pugi::xml_node kind, pitch;
+    for (pugi::xml_node a = interface.first_child(); a; a = a.next_sibling()) {
+      if (local_name(a) != "Attribute") continue;
+      const std::string_view name = a.attribute("Name").value();
+      if (name == "Joint") kind = a;
+      if (name == "Pitch") pitch = a;
+    }
+    if (!kind && !pitch) return std::nullopt;
+    const std::string interface_name = interface.attribute("Name").value();
+    if (!kind) throw DescriptionError(file_.where(pitch), "interface '" + interface_name + "' has a Pitch but no Joint");
+    Joint joint;
+    joint.where = file_.where(kind);
+    const std::string text = aml::attribute_text(kind).value_or("");
+    const auto parsed = joint_kind(text);
+    if (!parsed) {
+      throw DescriptionError(joint.where, "interface '" + interface_name + "' declares joint '" + text +
+                                              "', which is none of " + joint_names());
+    }
+    joint.kind = *parsed;
+    if (joint.kind == Joint::Kind::screw) {
+      if (!pitch) throw DescriptionError(joint.where, "screw joint of interface '" + interface_name + "' has no Pitch");
+      const SourceRef at = file_.where(pitch);
+      const std::string value = aml::attribute_text(pitch).value_or("");
+      char* end = nullptr;
+      const double number = std::strtod(value.c_str(), &end);
+      if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(number) || number <= 0) {
+        throw DescriptionError(at, "Pitch '" + value + "' of interface '" + interface_name + "' is not a length above 0");
+      }
+      joint.pitch = number * aml::length_unit_scale(pitch.attribute("Unit").value(), at);
+    } else if (pitch) {
+      throw DescriptionError(file_.where(pitch), "interface '" + interface_name + "' has a Pitch, but its joint is " +
+                                                     joint_name(joint.kind) + ", not a screw");
+    }
+    return joint;
   }
 
   static pugi::xml_node frame_attribute(const pugi::xml_node& interface) {
@@ -365,6 +407,7 @@ class CaexReader {
           p.interface = i.attribute("Name").value();
           p.where = file_.where(i);
           if (const auto f = frame_attribute(i)) p.frame = aml::parse_frame(f, file_);
+          if (const auto joint = joint_of(i)) p.joint = joint;
         });
         for_each_child(*c, "Attribute", [&](const pugi::xml_node& a) {
           const std::string name = a.attribute("Name").value();
