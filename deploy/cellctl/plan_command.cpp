@@ -1,6 +1,8 @@
 #include "deploy/cellctl/plan_command.hpp"
 
+#include <cstdio>
 #include <fstream>
+#include <unistd.h>
 #include <iostream>
 
 #include "deploy/cellctl/cell_config.hpp"
@@ -16,6 +18,21 @@
 
 namespace cellctl {
 
+namespace {
+
+// "  12.3 s  placed 4/15  motor" / "  12.5 s  backtrack 3: motor taken off"
+void print_progress(const twin::PlanProgress& p) {
+  char line[256];
+  if (p.event == twin::PlanProgress::Event::placed) {
+    std::snprintf(line, sizeof line, "%7.1f s  placed %zu/%zu  %s\n", p.seconds, p.placed, p.parts, p.part.c_str());
+  } else {
+    std::snprintf(line, sizeof line, "%7.1f s  backtrack %zu: %s taken off\n", p.seconds, p.backtracks, p.part.c_str());
+  }
+  std::cerr << line;
+}
+
+}  // namespace
+
 void add_plan_command(CLI::App& app, int& exit_code) {
   struct Options {
     std::string product;
@@ -29,6 +46,8 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     std::string cell;
     std::string prefer = "feasible";
     double margin_mm = 1.0;
+    double time_limit = 120;
+    bool quiet = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("plan", "Plan and validate the assembly by virtual assembly");
@@ -53,6 +72,12 @@ void add_plan_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"feasible", "margin"}));
   cmd->add_option("--margin-threshold", options->margin_mm, "A step with less room than this (mm) is a finding")
       ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--time-limit", options->time_limit,
+                  "Seconds the search may take; then it ends with the plan that holds the most parts and says why "
+                  "(0: no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--quiet", options->quiet, "No progress lines (they go to a terminal's stderr: a part placed, a backtrack)");
   cmd->callback([options, &exit_code] {
     if (options->prefer == "margin" && options->sequence != "search") {
       throw CLI::ValidationError("--prefer margin", "needs --sequence search (the paper's sequence does not go back)");
@@ -60,6 +85,8 @@ void add_plan_command(CLI::App& app, int& exit_code) {
     twin::PlannerOptions planning;
     planning.objective = options->prefer == "margin" ? twin::Objective::margin : twin::Objective::feasible;
     planning.margin_threshold = options->margin_mm / 1000;
+    planning.time_limit = options->time_limit;
+    if (!options->quiet && ::isatty(STDERR_FILENO)) planning.progress = print_progress;
     if (!options->cell.empty()) {
       const CellConfig cell = read_cell_config(options->cell);
       planning.gripper = cell.gripper;

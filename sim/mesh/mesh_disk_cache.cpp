@@ -19,7 +19,7 @@ namespace {
 
 constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
-constexpr std::uint32_t kVersion = 8;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept; 6: convex meshes' coarse hulls; 7: coarse margins measured exactly (6 could hold 3e35 m); 8: objects joined where they are not convex pieces
+constexpr std::uint32_t kVersion = 9;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept; 6: convex meshes' coarse hulls; 7: coarse margins measured exactly (6 could hold 3e35 m); 8: objects joined where they are not convex pieces; 9: corners welded by position alone
 
 // SHA-256 of the file's bytes, a NUL, then its extension (how it is read), in hex. Meshes come from
 // OEMs (the order desk): with a hash one can collide on purpose (FNV-1a was used before), a

@@ -287,8 +287,13 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   // <up_axis> is not: a mesh is in its part's frame, whose coordinates the product's links
   // use as the CAD system wrote them.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
-  const aiScene* scene = importer.ReadFile(
-      file.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  // Corners are welded by position alone: a vendor's STL gives each triangle its own normal,
+  // and corners that differ by their normal were not joined (a bearing: 10 512 open edges).
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                          aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                                          aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS);
+  const aiScene* scene = importer.ReadFile(file.string(), aiProcess_RemoveComponent | aiProcess_Triangulate |
+                                                              aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
   if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
     throw MeshError("cannot read mesh " + file.string() + ": " + importer.GetErrorString());
   }

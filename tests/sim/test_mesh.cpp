@@ -260,3 +260,31 @@ TEST_CASE("objects that are not convex pieces are joined into one piece, welded:
   CHECK(faceplate->pieces.size() > 1);
   CHECK(faceplate->repairs.joined_objects == 0);
 }
+
+TEST_CASE("a vendor's STL with a normal per triangle is welded by position: closed", "[mesh]") {
+  // A cube as a binary STL whose every triangle carries its face's normal (a bearing from a
+  // catalogue came in so with 10 512 open edges: corners that differ by their normals were
+  // kept apart).
+  const auto file = std::filesystem::temp_directory_path() / ("normals-" + std::to_string(::getpid()) + ".stl");
+  {
+    std::ofstream out(file, std::ios::binary);
+    out.write(std::string(80, ' ').data(), 80);
+    const std::uint32_t count = 12;
+    out.write(reinterpret_cast<const char*>(&count), 4);
+    const auto corner = [](int i) { return Eigen::Vector3f(i & 1 ? 1.f : 0.f, i & 2 ? 1.f : 0.f, i & 4 ? 1.f : 0.f); };
+    for (const auto& f : std::vector<std::array<int, 4>>{{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}}) {
+      for (const auto& t : {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]}}) {
+        const Eigen::Vector3f n = (corner(t[1]) - corner(t[0])).cross(corner(t[2]) - corner(t[0])).normalized();
+        out.write(reinterpret_cast<const char*>(n.data()), 12);
+        for (int c : t) out.write(reinterpret_cast<const char*>(corner(c).eval().data()), 12);
+        const std::uint16_t attributes = 0;
+        out.write(reinterpret_cast<const char*>(&attributes), 2);
+      }
+    }
+  }
+  const auto cube = sim::load_mesh(file, 1);
+  std::filesystem::remove(file);
+  CHECK(cube->vertices.size() == 8);
+  CHECK(cube->repairs.open_edges == 0);
+  CHECK(cube->convex);
+}

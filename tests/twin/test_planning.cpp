@@ -376,3 +376,30 @@ TEST_CASE("suggested precedences settle the open order: written into the product
   }
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("planning time: progress is told part by part, and a time limit ends the search with the reason",
+          "[planning][time]") {
+  const auto loaded = test::load(test::product("cranfield/cranfield.aml"));
+  auto sequence = twin::make_sequence_planner("search");
+  auto path = twin::make_path_planner("linear");
+  twin::PlannerOptions told;
+  std::vector<twin::PlanProgress> heard;
+  told.progress = [&](const twin::PlanProgress& p) { heard.push_back(p); };
+  const twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, told);
+  REQUIRE(plan.complete);
+  REQUIRE(heard.size() == plan.steps.size());  // no backtrack: one line per part
+  for (std::size_t k = 0; k < heard.size(); ++k) {
+    CHECK(heard[k].event == twin::PlanProgress::Event::placed);
+    CHECK(heard[k].placed == k + 1);
+    CHECK(heard[k].parts == 9);
+    CHECK(heard[k].part == loaded.product.parts()[plan.steps[k].part].name);
+  }
+  // A limit already past: nothing is tried, and the plan says why.
+  twin::PlannerOptions hurried;
+  hurried.time_limit = 1e-9;
+  const twin::Plan stopped = twin::plan_assembly(loaded, *sequence, *path, hurried);
+  CHECK_FALSE(stopped.complete);
+  const auto gave_up = std::find_if(stopped.findings.begin(), stopped.findings.end(), [](const auto& f) { return f.kind == "gave-up"; });
+  REQUIRE(gave_up != stopped.findings.end());
+  CHECK(gave_up->message.find("time limit") != std::string::npos);
+}

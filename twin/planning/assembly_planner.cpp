@@ -82,22 +82,38 @@ class Search {
         if (!sequence_.backtracks()) return give_up(part);
         continue;
       }
-      std::vector<Attempt> tried;
-      std::optional<Trajectory> trajectory;
-      while ((trajectory = path_.next(scene_, part, tried))) {
-        ++plan_.trajectories_simulated;
-        auto collision = scene_.simulate_grasps(part, *trajectory);
-        if (!collision) break;
-        if (!collision->with.empty()) {
-          (collision->member == "part" ? blocked_by_ : gripper_blocked_by_)[part].insert(collision->with);
-        }
-        if (!worst_.count(part) || collision->depth > worst_[part].depth) worst_[part] = *collision;
-        tried.push_back({std::move(*trajectory), collision});
-      }
-      if (!trajectory) {
+      if (out_of_time()) return false;
+      // What the geometry said before: a part that found no way in among some parts finds none
+      // among more of them (more stand in its way); a way found among some parts is free
+      // among fewer.
+      if (known_blocked(part)) {
         unplaceable_.insert(part);
         if (!sequence_.backtracks()) return give_up(part);
         continue;
+      }
+      std::vector<Attempt> tried;
+      std::optional<Trajectory> trajectory;
+      if (const Way* way = known_way(part)) {
+        trajectory = way->trajectory;
+        tried = way->tried;
+      } else {
+        while ((trajectory = path_.next(scene_, part, tried))) {
+          ++plan_.trajectories_simulated;
+          auto collision = scene_.simulate_grasps(part, *trajectory);
+          if (!collision) break;
+          if (!collision->with.empty()) {
+            (collision->member == "part" ? blocked_by_ : gripper_blocked_by_)[part].insert(collision->with);
+          }
+          if (!worst_.count(part) || collision->depth > worst_[part].depth) worst_[part] = *collision;
+          tried.push_back({std::move(*trajectory), collision});
+        }
+        if (!trajectory) {
+          blocked_among_[part].push_back(assembled_);
+          unplaceable_.insert(part);
+          if (!sequence_.backtracks()) return give_up(part);
+          continue;
+        }
+        ways_[part].push_back({assembled_, *trajectory, tried});
       }
       const Standing standing = stands_with(part);
       if (standing.falls) {
@@ -114,6 +130,7 @@ class Search {
       assembled_[part] = true;
       scene_.assemble(part);
       plan_.steps.push_back(std::move(step));
+      tell(PlanProgress::Event::placed, part);
       if (extend()) return true;
       if (!sequence_.backtracks() || stopped_) return false;
       if (plan_.steps.size() > deepest_.size()) deepest_ = plan_.steps;  // the best partial plan, for the report
@@ -123,6 +140,7 @@ class Search {
       assembled_[part] = false;
       ++plan_.backtracks;
       backtracked_.insert(part);
+      tell(PlanProgress::Event::backtrack, part);
       if (plan_.backtracks >= options_.max_backtracks) {
         stopped_ = true;
         if (!best_) {
@@ -136,6 +154,48 @@ class Search {
   }
 
   double margin_of(const PlanStep& step) const { return step.margin ? step.margin->distance : options_.margin_reach; }
+
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+
+  // Past the time limit the search stops where it stands (the report says so).
+  bool out_of_time() {
+    if (options_.time_limit <= 0 || seconds() < options_.time_limit) return false;
+    stopped_ = timed_out_ = true;
+    return true;
+  }
+
+  void tell(PlanProgress::Event event, PartIndex part) const {
+    if (!options_.progress) return;
+    options_.progress({event, name(part), plan_.steps.size(), assembled_.size(), plan_.backtracks, seconds()});
+  }
+
+  // `a` holds no part that `b` does not.
+  static bool within(const std::vector<bool>& a, const std::vector<bool>& b) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (a[i] && !b[i]) return false;
+    }
+    return true;
+  }
+
+  bool known_blocked(PartIndex part) const {
+    const auto it = blocked_among_.find(part);
+    if (it == blocked_among_.end()) return false;
+    return std::any_of(it->second.begin(), it->second.end(), [&](const auto& among) { return within(among, assembled_); });
+  }
+
+  struct Way {
+    std::vector<bool> among;  // the parts in place when it was found
+    Trajectory trajectory;
+    std::vector<Attempt> tried;
+  };
+  const Way* known_way(PartIndex part) const {
+    const auto it = ways_.find(part);
+    if (it == ways_.end()) return nullptr;
+    for (const Way& w : it->second) {
+      if (within(assembled_, w.among)) return &w;
+    }
+    return nullptr;
+  }
 
   struct Standing {
     std::optional<Instability> falls;  // what would move
@@ -282,6 +342,10 @@ class Search {
              "): the " + sequence_.name() + " sequence does not go back";
     }
     if (tried_.count(p)) return "it went in at times, but the remaining parts could not be completed after it";
+    if (timed_out_) {
+      return "not in place when the search reached its time limit (" + std::to_string(static_cast<int>(options_.time_limit)) +
+             " s) after " + std::to_string(plan_.backtracks) + " backtracks";
+    }
     if (stopped_) return "not in place when the search stopped after " + std::to_string(plan_.backtracks) + " backtracks";
     return "never reachable: the parts it is linked to could not be assembled";
   }
@@ -333,6 +397,13 @@ class Search {
                                 names});
     }
     report_open_order();
+    if (timed_out_ && !plan_.complete) {
+      plan_.findings.push_back({"gave-up",
+                                "the search reached its time limit of " + std::to_string(static_cast<int>(options_.time_limit)) +
+                                    " s after " + std::to_string(plan_.backtracks) + " backtracks; the plan holds the most "
+                                    "parts it had in place",
+                                {}});
+    }
     if (!plan_.complete) {
       std::vector<bool> in(assembled_.size(), false);
       for (const auto& s : plan_.steps) in[s.part] = true;
@@ -402,6 +473,10 @@ class Search {
   std::optional<std::pair<PartIndex, std::size_t>> stopped_at_;  // the part and step a sequence ended at
   const StabilityAnalysis* stability_;
   std::map<std::vector<bool>, Standing> standing_;  // by the parts in place, the new one among them
+  std::map<PartIndex, std::vector<std::vector<bool>>> blocked_among_;  // parts in place where a part found no way
+  std::map<PartIndex, std::vector<Way>> ways_;                       // and where it found one
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  bool timed_out_ = false;
   std::map<PartIndex, Instability> falls_;          // the last group each part would have made fall
 };
 

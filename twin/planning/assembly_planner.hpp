@@ -5,6 +5,7 @@
 // another order (if the sequence planner backtracks). The result is a plan and findings
 // for the designer.
 
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -73,6 +74,16 @@ struct Plan {
   bool stability = false;  // every state asked whether it stands (PlannerOptions::stability)
 };
 
+// How the search goes, for a person waiting: each part put in and each one taken off again.
+struct PlanProgress {
+  enum class Event { placed, backtrack };
+  Event event = Event::placed;
+  std::string part;
+  std::size_t placed = 0, parts = 0;  // in place now, of
+  std::size_t backtracks = 0;
+  double seconds = 0;  // since the search began
+};
+
 // What a search that goes back looks for among the orders the links allow.
 enum class Objective {
   feasible,  // the first order that goes together
@@ -81,6 +92,10 @@ enum class Objective {
 
 struct PlannerOptions {
   std::size_t max_backtracks = 10000;  // bounds the search on products that cannot be built
+  // s of wall time the search may take (0: no limit); at the limit it ends with the plan that
+  // holds the most parts so far and says why.
+  double time_limit = 0;
+  std::function<void(const PlanProgress&)> progress;  // told as the search goes, when set
   // Planning on from a partial assembly (virtual assembly has done these steps; they stand),
   // with `not_next` barred from being the next part after them (cell-sim found no path for
   // it there): the twin's way back to sequence planning.

@@ -84,7 +84,7 @@ def quat_wxyz(w, x, y, z):
 
 
 # The turn that makes a source's up +y.
-UP = {"+y": I3, "-y": rot_x(math.pi), "+z": [[1, 0, 0], [0, 0, 1], [0, -1, 0]]}
+UP = {"+y": I3, "-y": rot_x(math.pi), "+z": [[1, 0, 0], [0, 0, 1], [0, -1, 0]], "-z": [[1, 0, 0], [0, 0, -1], [0, 1, 0]]}
 
 # --- reading the source -------------------------------------------------------------------
 
@@ -288,13 +288,79 @@ def ikea(repo, spec):
     return parts, links
 
 
+def number(text):
+    """A number as the sources write them: 0.5, -pi/2, 2*pi/3."""
+    return PoseExpression().visit(ast.parse(str(text).replace("pi", "np.pi"), mode="eval").body)
+
+
+def compose(a, b):
+    return matmul(a[0], b[0]), [x + y for x, y in zip(apply(a[0], b[1]), a[1])]
+
+
+def inverse(a):
+    r = transpose(a[0])
+    return r, [-x for x in apply(r, a[1])]
+
+
+def o2ac(repo, spec):
+    """o2ac/o2ac-ur's assembly database (WRS task boards): frames_to_mate.csv mates a subframe
+    of a parent part to one of a child part, with an offset (rpy, xyz) in the parent's; each
+    part's subframes (object_metadata/<name>.yaml, pose_xyzrpy) and mesh pose. Composed as its
+    assembly_reader.py does: child = parent * parent_subframe * offset * child_subframe^-1,
+    the first parent at the origin. Meshes in millimetres. Needs PyYAML."""
+    import csv
+    import io
+    import yaml
+    folder = spec["folder"]
+    listed = yaml.safe_load(repo.read(folder + "/parts_list.yaml"))["parts_list"]
+    by_id = {p["id"]: p for p in listed}
+    meta = {}
+    for p in listed:
+        try:
+            meta[p["id"]] = yaml.safe_load(repo.read(f"{folder}/object_metadata/{p['name'].strip()}.yaml")) or {}
+        except subprocess.CalledProcessError:
+            meta[p["id"]] = {}
+
+    def xyzrpy(values):
+        v = [number(x) for x in values]
+        return euler_xyz(v[3], v[4], v[5]), v[:3]
+
+    def subframe(pid, name):
+        for sub in meta[pid].get("subframes", []):
+            if sub["name"] == name:
+                return xyzrpy(sub["pose_xyzrpy"])
+        raise SystemExit(f"o2ac: part {pid} has no subframe {name}")
+
+    world, links = {}, []
+    for row in csv.reader(io.StringIO(repo.read(folder + "/frames_to_mate.csv").decode())):
+        if not row or row[0].strip().startswith("#") or row[0].strip() == "parent_frame":
+            continue
+        row = [x.strip() for x in row]
+        parent, child = (f.split("_") for f in row[:2])
+        pid, cid = int(parent[1]), int(child[1])
+        world.setdefault(pid, (I3, [0.0, 0.0, 0.0]))
+        offset = (euler_xyz(number(row[2]), number(row[3]), number(row[4])), [number(x) for x in row[5:8]])
+        world[cid] = compose(compose(compose(world[pid], subframe(pid, "_".join(parent[2:]))), offset),
+                             inverse(subframe(cid, "_".join(child[2:]))))
+        links.append((pid, cid))
+    ids = sorted(world)
+    parts = []
+    for pid in ids:
+        pose = world[pid]
+        if meta[pid].get("mesh_pose"):
+            pose = compose(pose, xyzrpy(meta[pid]["mesh_pose"][0]["pose_xyzrpy"]))
+        parts.append(Part(by_id[pid]["name"].strip(), f"{folder}/meshes/{by_id[pid]['cad']}", pose[0], pose[1], 0.001))
+    index = {pid: k for k, pid in enumerate(ids)}
+    return parts, [(index[a], index[b]) for a, b in links]
+
+
 def identity(repo, spec):
     """Parts modelled in one frame (IsaacGymEnvs' Factory and IndustReal assets: the plug's
     pose equals the socket's when inserted)."""
     return [Part(n, p, I3, [0.0, 0.0, 0.0], spec.get("scale", 1.0)) for n, p in spec["parts"]], spec.get("links")
 
 
-READERS = {"asap": asap, "furniture-bench": furniture_bench, "ikea": ikea, "identity": identity}
+READERS = {"asap": asap, "furniture-bench": furniture_bench, "ikea": ikea, "identity": identity, "o2ac": o2ac}
 
 # --- the assemblies -----------------------------------------------------------------------
 
@@ -320,6 +386,11 @@ ASSEMBLIES = {
                                        parts=[("socket", f"{ISAAC}/industreal_pegs/industreal_tray_insert_rectangular_peg_8mm.obj"),
                                               ("peg", f"{ISAAC}/industreal_pegs/industreal_rectangular_peg_8mm.obj")],
                                        note="IndustReal's 8 mm rectangular peg in its socket."),
+    # Not kept in tests/data/real: its meshes are vendors' CAD whose terms are not checked.
+    "o2ac-wrs2020": dict(repo="o2ac/o2ac-ur", reader="o2ac", up="+y", licence="LICENSE",
+                         folder="catkin_ws/src/o2ac_assembly_database/config/wrs_assembly_2020",
+                         note="The WRS 2020 assembly task board: base, two plates, motor, pulleys, bearing, shaft, "
+                              "idler with its pin, nut and washer (the belt and screws left out)."),
     "factory-nut-bolt-m12": dict(repo="isaac-sim/IsaacGymEnvs", reader="identity", up="+z", licence="LICENSE.txt",
                                  parts=[("bolt", "assets/factory/mesh/factory_nut_bolt/factory_bolt_m12_loose.obj"),
                                         ("nut", "assets/factory/mesh/factory_nut_bolt/factory_nut_m12_loose_subdiv_3x.obj")],
