@@ -558,7 +558,12 @@ std::optional<Plan> plan_with_fixtures(const LoadedProduct& product, SequencePla
                                "step " + std::to_string(i + 1) + " (" + product.product.parts()[part].name +
                                    "): a fixture must hold " + describe(product.product, *falls, options.stand),
                                {product.product.parts()[part].name}});
+      continue;
     }
+    // Standing once fastened, not before: the arm holds it until then.
+    std::vector<bool> before = fastened;
+    for (std::size_t c : product.product.connections_of(part)) before[c] = false;
+    plan.steps[i].hold = before != fastened && stability.check(placed, held, before).has_value();
   }
   plan.stability = options.stability;
   plan.complete = options.fixtures;

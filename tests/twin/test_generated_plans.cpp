@@ -1,0 +1,74 @@
+// Property tests of planning on products made at random (tests/support/generated_products.hpp):
+// posts with tenons in beams' mortises, stacked blocks. For every one, whatever the search
+// concludes, the plan's independent replay agrees with it: the search never accepts a step the
+// replay refuses (a "verification" finding would mean the search missed a collision or a fall),
+// a plan called complete is verified, and a product made unbuildable (a tenon thicker than its
+// mortise) is never called complete. A failure names the seed that makes the product again.
+
+#include <catch2/catch.hpp>
+
+#include "tests/support/generated_products.hpp"
+#include "twin/planning/assembly_planner.hpp"
+#include "twin/planning/path_planner.hpp"
+
+namespace {
+
+// Fewer under the sanitizers, which run ten times slower.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr std::uint32_t kScale = 10;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(undefined_behavior_sanitizer)
+constexpr std::uint32_t kScale = 10;
+#else
+constexpr std::uint32_t kScale = 1;
+#endif
+#else
+constexpr std::uint32_t kScale = 1;
+#endif
+
+struct Tally {
+  std::size_t complete = 0, refused = 0;
+};
+
+void check(const test::Generated& g, Tally& tally) {
+  INFO(g.recipe);
+  twin::SearchSequencePlanner sequence;
+  twin::PlannerOptions options;
+  options.max_backtracks = 200;
+  const twin::Plan plan = twin::plan_assembly(g.product, sequence, *twin::make_path_planner("linear"), options);
+  for (const auto& f : plan.findings) {
+    INFO(f.message);
+    CHECK(f.kind != "verification");
+  }
+  REQUIRE(plan.verification.run);
+  if (plan.complete) {
+    CHECK(plan.verification.passed);
+    CHECK(plan.steps.size() == g.product.product.parts().size());
+    ++tally.complete;
+  } else {
+    ++tally.refused;
+  }
+  if (g.expect == test::Expect::refused) CHECK_FALSE(plan.complete);
+  if (g.expect == test::Expect::buildable) CHECK(plan.complete);
+}
+
+}  // namespace
+
+TEST_CASE("generated products: posts with tenons in beams, every plan agrees with its replay", "[planning][generated]") {
+  Tally tally;
+  const std::uint32_t count = 1000 / kScale;
+  for (std::uint32_t seed = 1; seed <= count; ++seed) check(test::posts_and_beams(seed), tally);
+  INFO(tally.complete << " complete, " << tally.refused << " refused");
+  // Neither side empty: the products are made to come out both ways.
+  CHECK(tally.complete > count / 4);
+  CHECK(tally.refused > count / 10);
+}
+
+TEST_CASE("generated products: stacked blocks, every plan agrees with its replay", "[planning][generated]") {
+  Tally tally;
+  const std::uint32_t count = 1000 / kScale;
+  for (std::uint32_t seed = 1; seed <= count; ++seed) check(test::stacked_blocks(seed), tally);
+  INFO(tally.complete << " complete, " << tally.refused << " refused");
+  CHECK(tally.complete > count / 4);
+  CHECK(tally.refused > count / 10);
+}
