@@ -597,7 +597,21 @@ class Replay {
       const double mid = (s0 + s1) / 2;
       return self(self, s0, mid) && self(self, mid, s1);
     };
-    if (travel > 0) check(check, 0.0, 1.0);
+    if (travel > step) {
+      // Most moves touch only where they end (a part set down on its seat): the end pose is
+      // measured, and the rest, up to one step short of it, swept whole.
+      const double last = 1 - step / travel;
+      if (!(found = at_pose(members, to, around, phase))) {
+        if (may_touch(members, from, shift * last, around)) {
+          check(check, 0.0, last);
+        }
+      } else {
+        at = 1;
+        check(check, 0.0, 1.0);  // where along the move it begins
+      }
+    } else if (travel > 0) {
+      check(check, 0.0, 1.0);
+    }
     if (found) deepest_after(*found, members, from, to, at, travel, around);
     return found;
   }
