@@ -48,14 +48,16 @@ std::vector<ContactPoint> patch_corners(const std::vector<ContactPoint>& patch) 
   const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
   std::vector<std::size_t> order(patch.size());
   std::iota(order.begin(), order.end(), 0);
-  const auto uv = [&](std::size_t i) { return Eigen::Vector2d(u.dot(patch[i].point), v.dot(patch[i].point)); };
+  std::vector<Eigen::Vector2d> in_plane(patch.size());
+  for (std::size_t i = 0; i < patch.size(); ++i) in_plane[i] = {u.dot(patch[i].point), v.dot(patch[i].point)};
+  const auto uv = [&](std::size_t i) -> const Eigen::Vector2d& { return in_plane[i]; };
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const auto pa = uv(a), pb = uv(b);
+    const auto &pa = uv(a), &pb = uv(b);
     return pa.x() < pb.x() || (pa.x() == pb.x() && pa.y() < pb.y());
   });
   // Andrew's monotone chain.
   const auto cross = [&](std::size_t o, std::size_t a, std::size_t b) {
-    const auto po = uv(o), pa = uv(a), pb = uv(b);
+    const auto &po = uv(o), &pa = uv(a), &pb = uv(b);
     return (pa.x() - po.x()) * (pb.y() - po.y()) - (pa.y() - po.y()) * (pb.x() - po.x());
   };
   std::vector<std::size_t> hull(2 * order.size());
@@ -117,6 +119,8 @@ struct StabilityAnalysis::Impl {
   // normal the way b is pushed.
   mutable std::map<std::pair<PartIndex, PartIndex>, std::vector<ContactPoint>> pairs;
   mutable std::map<std::vector<double>, std::optional<Instability>> answers;  // check(), by state
+  // on_station(), by part and pose (its 3x4 matrix)
+  mutable std::map<std::pair<PartIndex, std::array<double, 12>>, std::vector<ContactPoint>> stations;
 
   const PartFacts& facts_of(PartIndex p) const {
     auto [it, made] = facts.try_emplace(p);
@@ -229,8 +233,16 @@ struct StabilityAnalysis::Impl {
       const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
       return n.norm() == 0 ? Vec3(Vec3::Zero()) : Vec3(n.normalized() * orientation);
     };
-    std::vector<Vec3> a_normals;
-    for (const auto& [f, fb] : of_a) a_normals.push_back(outward(f, fa.orientation));
+    // a's faces by the x of their outward normal: a face of b can face only those whose
+    // normal's x is within kFacing of the opposite of its own.
+    constexpr double kFacingCos = -0.999;
+    const double kFacing = std::sqrt(2 * (1 + kFacingCos));  // |n + nb| at that angle
+    std::vector<std::pair<Vec3, std::size_t>> a_normals;  // (out of a, index in of_a)
+    for (std::size_t i = 0; i < of_a.size(); ++i) {
+      const Vec3 n = outward(of_a[i].first, fa.orientation);
+      if (!n.isZero()) a_normals.emplace_back(n, i);
+    }
+    std::sort(a_normals.begin(), a_normals.end(), [](const auto& x, const auto& y) { return x.first.x() < y.first.x(); });
     const double b_orientation = facts_of(b).orientation;
     for (const auto& [t, tb] : of_b) {
       const Vec3 nb = outward(t, b_orientation);
@@ -238,32 +250,37 @@ struct StabilityAnalysis::Impl {
       Eigen::AlignedBox3d reach = tb;
       reach.extend(reach.min() - grow);
       reach.extend(reach.max() + grow);
-      for (std::size_t i = 0; i < of_a.size(); ++i) {
-        const Vec3& n = a_normals[i];  // out of a
+      const auto first = std::lower_bound(a_normals.begin(), a_normals.end(), -nb.x() - kFacing,
+                                          [](const auto& x, double v) { return x.first.x() < v; });
+      for (auto it = first; it != a_normals.end() && it->first.x() <= -nb.x() + kFacing; ++it) {
+        const Vec3& n = it->first;
         // Facing each other (b's face looks into a), in one plane to the contact distance.
-        if (nb.dot(n) > -0.999) continue;
-        const auto& [f, fb] = of_a[i];
+        if (nb.dot(n) > kFacingCos) continue;
+        const auto& [f, fb] = of_a[it->second];
         if (!reach.intersects(fb)) continue;
         if (std::abs(n.dot(t[0] - f[0])) > options.contact_distance || std::abs(n.dot(t[1] - f[0])) > options.contact_distance ||
             std::abs(n.dot(t[2] - f[0])) > options.contact_distance) {
           continue;
         }
         const Vec3 wound = (f[1] - f[0]).cross(f[2] - f[0]);
-        std::vector<Vec3> polygon(t.begin(), t.end());
-        for (Vec3& p : polygon) p -= n * n.dot(p - f[0]);  // into a's plane
-        for (int k = 0; k < 3 && !polygon.empty(); ++k) {
+        // A triangle cut by three lines has at most six corners.
+        std::array<Vec3, 6> polygon{t[0], t[1], t[2]}, kept;
+        std::size_t corners = 3;
+        for (std::size_t i = 0; i < corners; ++i) polygon[i] -= n * n.dot(polygon[i] - f[0]);  // into a's plane
+        for (int k = 0; k < 3 && corners > 0; ++k) {
           const Vec3 &e0 = f[k], &e1 = f[(k + 1) % 3];
           const Vec3 inward = wound.cross(e1 - e0);  // towards the inside of a's triangle
-          std::vector<Vec3> kept;
-          for (std::size_t i = 0; i < polygon.size(); ++i) {
-            const Vec3 &p = polygon[i], &q = polygon[(i + 1) % polygon.size()];
+          std::size_t left = 0;
+          for (std::size_t i = 0; i < corners; ++i) {
+            const Vec3 &p = polygon[i], &q = polygon[(i + 1) % corners];
             const double dp = inward.dot(p - e0), dq = inward.dot(q - e0);
-            if (dp >= 0) kept.push_back(p);
-            if ((dp >= 0) != (dq >= 0)) kept.push_back(p + (q - p) * (dp / (dp - dq)));
+            if (dp >= 0 && left < kept.size()) kept[left++] = p;
+            if ((dp >= 0) != (dq >= 0) && left < kept.size()) kept[left++] = p + (q - p) * (dp / (dp - dq));
           }
-          polygon = std::move(kept);
+          polygon = kept;
+          corners = left;
         }
-        for (const Vec3& p : polygon) out.push_back({p, n});
+        for (std::size_t i = 0; i < corners; ++i) out.push_back({polygon[i], n});
       }
     }
   }
@@ -294,7 +311,6 @@ struct StabilityAnalysis::Impl {
 
   // Contacts of a part with the station's surface (y = 0) where it stands at `pose`: its
   // corners that lie within the contact distance of it, in the world, pushed up.
-  mutable std::map<std::pair<PartIndex, std::array<double, 12>>, std::vector<ContactPoint>> stations;
   const std::vector<ContactPoint>& on_station(PartIndex p, const Pose& pose) const {
     std::array<double, 12> key;
     std::copy(pose.matrix().data(), pose.matrix().data() + 12, key.begin());
@@ -311,7 +327,7 @@ struct StabilityAnalysis::Impl {
 };
 
 StabilityAnalysis::StabilityAnalysis(const LoadedProduct& product, StabilityOptions options)
-    : impl_(std::make_unique<Impl>(Impl{product, options, {}, {}, {}})), options_(options) {}
+    : impl_(std::make_unique<Impl>(Impl{product, options, {}, {}, {}, {}})), options_(options) {}
 
 StabilityAnalysis::~StabilityAnalysis() = default;
 
