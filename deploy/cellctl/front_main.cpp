@@ -19,6 +19,7 @@
 #include "deploy/cellctl/plan_command.hpp"
 #include "deploy/cellctl/processes.hpp"
 #include "deploy/cellctl/run_app.hpp"
+#include "twin/planning/work_memory.hpp"
 
 namespace {
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     std::cerr << "error: cannot run " << full << ": " << std::strerror(errno) << '\n';
     return 1;
   }
+  twin::keep_work_memory();
   CLI::App app{cellctl::kDescription};
   app.require_subcommand(1);
   int exit_code = 0;

@@ -10,8 +10,10 @@
 #include "deploy/cellctl/plan_command.hpp"
 #include "deploy/cellctl/quote_command.hpp"
 #include "deploy/cellctl/run_app.hpp"
+#include "twin/planning/work_memory.hpp"
 
 int main(int argc, char** argv) {
+  twin::keep_work_memory();
   CLI::App app{cellctl::kDescription};
   app.require_subcommand(1);
   int exit_code = 0;

@@ -1,6 +1,7 @@
 #include "sim/mesh/triangle_mesh.hpp"
 
 #include "sim/mesh/mesh_disk_cache.hpp"
+#include "sim/mesh/mesh_import.hpp"
 #include "sim/mesh/triangle_bvh.hpp"
 
 #include <BulletCollision/CollisionShapes/btConvexHullShape.h>
@@ -14,36 +15,8 @@
 #include <map>
 #include <set>
 
-#include <assimp/Importer.hpp>
-#include <assimp/config.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-
 namespace sim {
 namespace {
-
-void append_node(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent, TriangleMesh& out) {
-  const aiMatrix4x4 transform = parent * node.mTransformation;
-  for (unsigned m = 0; m < node.mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene.mMeshes[node.mMeshes[m]];
-    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
-    const auto base = static_cast<std::uint32_t>(out.vertices.size());
-    std::vector<std::uint32_t> piece;
-    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-      const aiVector3D p = transform * mesh.mVertices[v];
-      out.vertices.emplace_back(p.x, p.y, p.z);
-      out.bounds.extend(out.vertices.back());
-      piece.push_back(base + v);
-    }
-    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-      const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      out.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
-    }
-    out.pieces.push_back(std::move(piece));
-  }
-  for (unsigned c = 0; c < node.mNumChildren; ++c) append_node(scene, *node.mChildren[c], transform, out);
-}
 
 bool has_edge(const std::array<std::uint32_t, 3>& t, std::uint32_t a, std::uint32_t b) {
   for (int k = 0; k < 3; ++k) {
@@ -282,23 +255,8 @@ std::string TriangleMesh::Repairs::describe() const {
 }
 
 std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file, double scale) {
-  Assimp::Importer importer;
-  // A COLLADA file's <unit> is applied (it is the file's own statement of its unit); its
-  // <up_axis> is not: a mesh is in its part's frame, whose coordinates the product's links
-  // use as the CAD system wrote them.
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
-  // Corners are welded by position alone: a vendor's STL gives each triangle its own normal,
-  // and corners that differ by their normal were not joined (a bearing: 10 512 open edges).
-  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                                          aiComponent_COLORS | aiComponent_TEXCOORDS |
-                                                          aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS);
-  const aiScene* scene = importer.ReadFile(file.string(), aiProcess_RemoveComponent | aiProcess_Triangulate |
-                                                              aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
-  if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
-    throw MeshError("cannot read mesh " + file.string() + ": " + importer.GetErrorString());
-  }
   auto mesh = std::make_shared<TriangleMesh>();
-  append_node(*scene, *scene->mRootNode, aiMatrix4x4(), *mesh);
+  import_mesh(file, *mesh);
   if (mesh->triangles.empty()) throw MeshError("mesh " + file.string() + " holds no triangles");
   if (mesh->pieces.size() > 1 && !convex_pieces(*mesh)) join_pieces(*mesh);
   if (scale != 1) {

@@ -43,6 +43,7 @@
 #include "twin/report/gltf_animation.hpp"
 #include "twin/report/html_report.hpp"
 #include "twin/report/plan_json.hpp"
+#include "twin/planning/work_memory.hpp"
 #include "services/node/run.hpp"
 #include "services/state/cell_store.hpp"
 
@@ -530,6 +531,7 @@ bool read_standby_order(std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  twin::keep_work_memory();
   CLI::App app{"twin: the digital twin of one order"};
   Options o;
   bool all_interfaces = false, standby = false;

@@ -77,6 +77,15 @@ class Shape {
       const Vec3 outward = n.normalized() * (volume < 0 ? -1 : 1);
       planes_.emplace_back(outward, outward.dot(t[0]));
     }
+    // A face of several triangles is one plane: every depth is a least over the planes, so
+    // each is kept once (to a nanometre; a near twin left is only asked twice).
+    const auto key = [](const std::pair<Vec3, double>& p) {
+      return std::array<long long, 4>{std::llround(p.first.x() * 1e9), std::llround(p.first.y() * 1e9),
+                                      std::llround(p.first.z() * 1e9), std::llround(p.second * 1e9)};
+    };
+    std::sort(planes_.begin(), planes_.end(), [&](const auto& a, const auto& b) { return key(a) < key(b); });
+    planes_.erase(std::unique(planes_.begin(), planes_.end(), [&](const auto& a, const auto& b) { return key(a) == key(b); }),
+                  planes_.end());
   }
 
   const std::vector<Triangle>& triangles() const { return triangles_; }
@@ -202,18 +211,8 @@ bool closed_convex(const sim::TriangleMesh& mesh) {
   return true;
 }
 
-// One piece of a mesh authored as pieces, as its own mesh: its triangles where they close a
-// convex solid, else its hull (planning takes each piece's hull).
-sim::TriangleMesh piece_mesh(const sim::TriangleMesh& mesh, const std::vector<std::uint32_t>& piece) {
-  std::vector<std::uint32_t> index(mesh.vertices.size(), ~0u);
-  sim::TriangleMesh out;
-  for (auto v : piece) {
-    index[v] = static_cast<std::uint32_t>(out.vertices.size());
-    out.vertices.push_back(mesh.vertices[v]);
-  }
-  for (const auto& t : mesh.triangles) {
-    if (index[t[0]] != ~0u && index[t[1]] != ~0u && index[t[2]] != ~0u) out.triangles.push_back({index[t[0]], index[t[1]], index[t[2]]});
-  }
+// The mesh where it closes a convex solid, else its hull.
+sim::TriangleMesh closed_or_hull(sim::TriangleMesh out) {
   if (closed_convex(out)) return out;
   using Exact = CGAL::Exact_predicates_inexact_constructions_kernel;
   std::vector<Exact::Point_3> points;
@@ -233,6 +232,27 @@ sim::TriangleMesh piece_mesh(const sim::TriangleMesh& mesh, const std::vector<st
     for (std::size_t k = 1; k + 1 < corners.size(); ++k) h.triangles.push_back({corners[0], corners[k], corners[k + 1]});
   }
   return h;
+}
+
+// Each piece of a mesh authored as pieces, as its own mesh (a triangle belongs to the piece of
+// its corners): its triangles where they close a convex solid, else its hull (planning takes
+// each piece's hull).
+std::vector<sim::TriangleMesh> piece_meshes(const sim::TriangleMesh& mesh) {
+  std::vector<sim::TriangleMesh> out(mesh.pieces.size());
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> at(mesh.vertices.size(), {~0u, ~0u});  // piece, index in it
+  for (std::uint32_t p = 0; p < mesh.pieces.size(); ++p) {
+    for (auto v : mesh.pieces[p]) {
+      at[v] = {p, static_cast<std::uint32_t>(out[p].vertices.size())};
+      out[p].vertices.push_back(mesh.vertices[v]);
+    }
+  }
+  for (const auto& t : mesh.triangles) {
+    const auto piece = at[t[0]].first;
+    if (piece == ~0u || at[t[1]].first != piece || at[t[2]].first != piece) continue;
+    out[piece].triangles.push_back({at[t[0]].second, at[t[1]].second, at[t[2]].second});
+  }
+  for (auto& piece : out) piece = closed_or_hull(std::move(piece));
+  return out;
 }
 
 bool degenerate(const Triangle& t) { return (t[1] - t[0]).cross(t[2] - t[0]).squaredNorm() < 1e-24; }
@@ -323,7 +343,7 @@ class Replay {
   Replay(const LoadedProduct& product, const Plan& plan, const VerifyOptions& options)
       : product_(product), plan_(plan), options_(options) {
     if (options.stability && !options.analysis) own_stability_.emplace(product, options.stand);
-    stability_ = options.analysis ? options.analysis : own_stability_ ? &*own_stability_ : nullptr;
+    if (options.stability) stability_ = options.analysis ? options.analysis : &*own_stability_;
     // The station: a slab whose top is the assembly surface, as planning has it.
     Pose slab = Pose::Identity();
     slab.translation() = Vec3(0, -0.025, 0);
@@ -355,8 +375,7 @@ class Replay {
     auto [shapes, made] = shapes_.try_emplace(mesh.get());
     if (made && mesh) {
       if (mesh->pieces.size() > 1) {
-        for (const auto& piece : mesh->pieces) {
-          const sim::TriangleMesh own = piece_mesh(*mesh, piece);
+        for (const auto& own : piece_meshes(*mesh)) {
           shapes->second.push_back(std::make_unique<Shape>(own, own.triangles.size() >= 4));
         }
       } else {
@@ -470,13 +489,14 @@ class Replay {
       const Eigen::AlignedBox3d box = moved_box(m.box, at);
       for (const Placed& o : around) {
         if (!box.intersects(o.box)) continue;
+        shapes_near(o, box);
         for (const auto& a : *m.shapes) {
           const Eigen::AlignedBox3d a_box = moved_box(a->box(), at);
           if (!a_box.intersects(o.box)) continue;
-          for (std::size_t k = 0; k < o.body->shapes->size(); ++k) {
+          for (std::size_t k : obstacle_shapes_) {
             if (!a_box.intersects(o.shape_boxes[k])) continue;
             if (auto deep = deeper(*a, at, *(*o.body->shapes)[k], o.pose, options_.contact_tolerance, o.body == &station_)) {
-              return Violation{0, phase, m.name, o.body->name, deep->depth, deep->point};
+              return Violation{0, phase, m.name, o.body->name, deep->depth, deep->point, {}};
             }
           }
         }
@@ -528,18 +548,27 @@ class Replay {
     for (const Body& m : members) {
       const Pose at = pose * m.offset;
       const Eigen::AlignedBox3d m_swept = swept(moved_box(m.box, at));
-      if (std::none_of(around.begin(), around.end(), [&](const Placed& o) { return m_swept.intersects(o.box); })) continue;
-      for (const auto& a : *m.shapes) {
-        const Eigen::AlignedBox3d a_swept = swept(moved_box(a->box(), at));
-        for (const Placed& o : around) {
+      for (const Placed& o : around) {
+        if (!m_swept.intersects(o.box)) continue;
+        shapes_near(o, m_swept);
+        for (const auto& a : *m.shapes) {
+          const Eigen::AlignedBox3d a_swept = swept(moved_box(a->box(), at));
           if (!a_swept.intersects(o.box)) continue;
-          for (std::size_t k = 0; k < o.body->shapes->size(); ++k) {
+          for (std::size_t k : obstacle_shapes_) {
             if (a_swept.intersects(o.shape_boxes[k]) && sweep_meets(*a, at, shift, *(*o.body->shapes)[k], o.pose)) return true;
           }
         }
       }
     }
     return false;
+  }
+
+  // The obstacle's shapes whose boxes meet `box` (world), into obstacle_shapes_.
+  void shapes_near(const Placed& o, const Eigen::AlignedBox3d& box) {
+    obstacle_shapes_.clear();
+    for (std::size_t k = 0; k < o.shape_boxes.size(); ++k) {
+      if (box.intersects(o.shape_boxes[k])) obstacle_shapes_.push_back(k);
+    }
   }
 
   bool sweep_meets(const Shape& a, const Pose& at, const Vec3& shift, const Shape& b, const Pose& pb) {
@@ -670,7 +699,7 @@ class Replay {
   };
   std::map<double, Gripper> grippers_;
   std::vector<std::optional<Pose>> placed_;
-  std::vector<std::size_t> near_, against_;  // kept between calls: no allocation per query
+  std::vector<std::size_t> near_, against_, obstacle_shapes_;  // kept between calls: no allocation per query
   std::optional<StabilityAnalysis> own_stability_;
   const StabilityAnalysis* stability_ = nullptr;
   std::vector<PartIndex> held_;  // by the plan's fixtures
