@@ -1,22 +1,37 @@
 #!/usr/bin/env bash
-# Installs every Debian package the project needs to build, test and run.
+# Installs the Debian packages the project needs: with no argument, what building and running
+# the cell takes (deploy/run-example.sh); with --tests, also what the tests, the benchmarks,
+# the sanitizer builds and the fuzzers take (deploy/test.sh).
 # Idempotent and non-interactive: packages already present are skipped.
 set -euo pipefail
 
+tests=false
+case "${1:-}" in
+  "") ;;
+  --tests) tests=true ;;
+  *) echo "usage: $0 [--tests]" >&2; exit 2 ;;
+esac
+
 packages=(
   build-essential cmake ninja-build pkg-config
-  libeigen3-dev libbullet-dev libpugixml-dev catch2
-  libassimp-dev libtinygltf-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libyaml-cpp-dev
+  libeigen3-dev libbullet-dev libpugixml-dev libcgal-dev
+  coinor-libclp-dev  # the linear programs of the gravity check (twin/planning/stability.cpp)
+  libassimp-dev libtinygltf-dev libcli11-dev nlohmann-json3-dev libyaml-cpp-dev
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
-  libbenchmark-dev libsqlite3-dev sqlite3 libcgal-dev
-  libfcl-dev libopenvdb-dev libboost-iostreams-dev libbullet-extras-dev  # only for bench_collision_libraries:
-                 # our check against FCL's, OpenVDB's distance fields (its CMake module wants Boost
-                 # iostreams, which the package does not pull) and Bullet's HACD decomposition
+  libsqlite3-dev sqlite3
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
-  chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
-  clang libclang-rt-14-dev  # the sanitizer builds and the libFuzzer targets (deploy/test.sh)
 )
+if $tests; then
+  packages+=(
+    catch2 libbenchmark-dev
+    libfcl-dev libopenvdb-dev libboost-iostreams-dev libbullet-extras-dev  # only for bench_collision_libraries:
+                   # our check against FCL's, OpenVDB's distance fields (its CMake module wants Boost
+                   # iostreams, which the package does not pull) and Bullet's HACD decomposition
+    chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
+    clang libclang-rt-14-dev  # the sanitizer builds and the libFuzzer targets (deploy/test.sh)
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -25,7 +40,9 @@ done
 
 # Node.js runs the Khronos glTF validator in the tests; a machine that has node and npm
 # already (from whichever source) keeps them.
-command -v node >/dev/null && command -v npm >/dev/null || missing+=(nodejs npm)
+if $tests; then
+  command -v node >/dev/null && command -v npm >/dev/null || missing+=(nodejs npm)
+fi
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all packages present"
@@ -38,6 +55,7 @@ else
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+$tests || exit 0
 # The glTF validator, pinned by tests/gltf/package-lock.json.
 cd "$(dirname "$0")/.."
 [ -d tests/gltf/node_modules/gltf-validator ] || npm ci --prefix tests/gltf --no-audit --no-fund --loglevel=error

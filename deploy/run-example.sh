@@ -11,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELL_BUILD_TESTS=OFF >/dev/null
 cmake --build build/release -j "$(nproc)" --target cellctl
 mkdir -p out
 build/release/bin/cellctl describe deploy/products/cranfield/cranfield.aml
