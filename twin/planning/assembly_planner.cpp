@@ -121,7 +121,7 @@ class Search {
         if (!sequence_.backtracks()) return give_up(part);
         continue;
       }
-      PlanStep step{part, std::move(*trajectory), std::move(tried), allowed, "", {}, std::nullopt, false, standing.hold};
+      PlanStep step{part, std::move(*trajectory), std::move(tried), allowed, "", {}, std::nullopt, false, standing.hold, {}};
       if (options_.objective == Objective::margin) {
         measure(step);
         // No order through this step beats the best found: its least margin is at most this.
@@ -492,7 +492,9 @@ std::string step_name(const Product& product, const PlanStep& step) {
 
 std::string step_result(const PlanStep& step) {
   std::string out = step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)";
-  return step.hold ? out + ", held until fastened" : out;
+  if (step.hold) out += ", held until fastened";
+  if (!step.fixture.empty()) out += ", a fixture holds " + std::to_string(step.fixture.size()) + " part(s) from here";
+  return out;
 }
 
 double least_margin(const std::vector<PlanStep>& steps, double reach) {

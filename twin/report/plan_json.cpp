@@ -17,6 +17,13 @@ nlohmann::json margin_json(const PlanStep& step, double reach) {
   return {{"distance", m.distance}, {"with", m.with}, {"member", m.member}, {"phase", m.phase}};
 }
 
+// The parts a fixture holds from this step on, by name.
+nlohmann::json fixture_names(const Product& product, const PlanStep& step) {
+  nlohmann::json names = nlohmann::json::array();
+  for (PartIndex p : step.fixture) names.push_back(product.parts()[p].name);
+  return names;
+}
+
 }  // namespace
 
 nlohmann::json plan_json(const Product& product, const Plan& plan) {
@@ -58,6 +65,7 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                      {"path_length", step.trajectory.path_length()},
                      {"tries", step.failed.size() + 1},
                      {"hold", step.hold},
+                     {"fixture", fixture_names(product, step)},
                      {"failed_tries", failed},
                      {"margin", margin_json(step, plan.margin_reach)},
                      {"trajectory", trajectory}});
