@@ -49,6 +49,10 @@ Triangle moved(Triangle t, const Pose& pose) {
   return t;
 }
 
+Kernel::Triangle_3 cgal_triangle(const Triangle& t) {
+  return {{t[0].x(), t[0].y(), t[0].z()}, {t[1].x(), t[1].y(), t[1].z()}, {t[2].x(), t[2].y(), t[2].z()}};
+}
+
 // A closed shape of the replay, in its own frame: a part's mesh where it is one piece, each
 // piece where the mesh is authored as convex pieces (its hull where the piece is not closed
 // and convex: planning takes the hulls), a gripper's box, the station's slab.
@@ -148,9 +152,30 @@ class Shape {
   // Whether the shape has an inside: a mesh that is not closed has none, and what crosses
   // its surface cannot be measured.
   bool closed() const { return convex() || solid().inside != nullptr; }
-  bool crosses(const Triangle& t) const {
-    return solid().surface->do_intersect(Kernel::Triangle_3({t[0].x(), t[0].y(), t[0].z()}, {t[1].x(), t[1].y(), t[1].z()},
-                                                            {t[2].x(), t[2].y(), t[2].z()}));
+  // How far a triangle (own frame) that meets the surface reaches through it: at each face it
+  // meets, the lesser of how far it reaches to either side of the face's plane. One that lies
+  // on the surface, or touches it, reaches through by nothing; none if it does not meet it.
+  std::optional<double> crossing_depth(const Triangle& t) const {
+    faces_.clear();
+    solid().surface->all_intersected_primitives(cgal_triangle(t), std::back_inserter(faces_));
+    if (faces_.empty()) return std::nullopt;
+    const auto& m = solid().mesh;
+    double deepest = 0;
+    for (const auto f : faces_) {
+      const auto h = m.halfedge(f);
+      const auto &a = m.point(m.source(h)), &b = m.point(m.target(h)), &c = m.point(m.target(m.next(h)));
+      const Vec3 p(a.x(), a.y(), a.z());
+      const Vec3 n = (Vec3(b.x(), b.y(), b.z()) - p).cross(Vec3(c.x(), c.y(), c.z()) - p);
+      if (n.squaredNorm() == 0) continue;
+      double above = 0, below = 0;
+      for (const Vec3& v : t) {
+        const double d = n.normalized().dot(v - p);
+        above = std::max(above, d);
+        below = std::max(below, -d);
+      }
+      deepest = std::max(deepest, std::min(above, below));
+    }
+    return deepest;
   }
 
  private:
@@ -167,6 +192,7 @@ class Shape {
   double radius_ = 0;
   std::vector<std::pair<Vec3, double>> planes_;  // a convex shape's: outward normal n, offset d
   mutable std::unique_ptr<sim::Solid> solid_;
+  mutable std::vector<sim::Solid::Tree::Primitive_id> faces_;  // kept between calls
 };
 
 sim::TriangleMesh box_mesh(const Vec3& half, const Pose& pose) {
@@ -257,9 +283,6 @@ std::vector<sim::TriangleMesh> piece_meshes(const sim::TriangleMesh& mesh) {
 
 bool degenerate(const Triangle& t) { return (t[1] - t[0]).cross(t[2] - t[0]).squaredNorm() < 1e-24; }
 
-Kernel::Triangle_3 cgal_triangle(const Triangle& t) {
-  return {{t[0].x(), t[0].y(), t[0].z()}, {t[1].x(), t[1].y(), t[1].z()}, {t[2].x(), t[2].y(), t[2].z()}};
-}
 
 // Whether a plane keeps the two triangles apart all along the move (they may touch it): then
 // their surfaces never cross there (a finger backing away along the face it held, a face
@@ -354,6 +377,8 @@ class Replay {
   Verification run() {
     placed_.assign(product_.product.parts().size(), std::nullopt);
     for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
+      // The plan's fixtures hold these from this step on, whatever the replay finds in it.
+      held_.insert(held_.end(), plan_.steps[i].fixture.begin(), plan_.steps[i].fixture.end());
       auto violation = replay(plan_.steps[i]);
       if (!violation) violation = falls_after(plan_.steps[i]);
       if (violation) {
@@ -470,7 +495,6 @@ class Replay {
       fastened[c] = k.joint.fastens() && placed_[k.part1] && placed_[k.part2];
       if (!step.hold && (k.part1 == step.part || k.part2 == step.part)) fastened[c] = false;
     }
-    held_.insert(held_.end(), step.fixture.begin(), step.fixture.end());  // the plan's fixtures hold these
     const auto falls = stability_->check(placed, held_, fastened);
     if (!falls) return std::nullopt;
     Violation v;
@@ -495,8 +519,9 @@ class Replay {
           if (!a_box.intersects(o.box)) continue;
           for (std::size_t k : obstacle_shapes_) {
             if (!a_box.intersects(o.shape_boxes[k])) continue;
-            if (auto deep = deeper(*a, at, *(*o.body->shapes)[k], o.pose, options_.contact_tolerance, o.body == &station_)) {
-              return Violation{0, phase, m.name, o.body->name, deep->depth, deep->point, {}};
+            const Shape& b = *(*o.body->shapes)[k];
+            if (auto deep = deeper(*a, at, b, o.pose, options_.contact_tolerance, o.body == &station_)) {
+              return Violation{0, phase, m.name, o.body->name, deep->depth, deep->point, {}, !a->closed() || !b.closed()};
             }
           }
         }
@@ -522,8 +547,13 @@ class Replay {
       for (std::size_t i : near_) {
         const Triangle t = moved(x.triangles()[i], to_y);
         if (!measurable) {
-          // No inside to measure: a surface crossing it counts.
-          if (!degenerate(t) && y.crosses(t)) return sim::DeepPoint{0, py * t[0]};
+          // No inside to measure: a surface reaching through it past the floor counts.
+          const auto through = degenerate(t) ? std::nullopt : y.crossing_depth(t);
+          if (through && *through > floor) {
+            found = sim::DeepPoint{*through, py * ((t[0] + t[1] + t[2]) / 3)};
+            if (!deepest) return found;
+            floor = *through + options_.resolution;
+          }
           continue;
         }
         if (const auto deep = y.deeper_than(t, floor, options_.resolution, deepest)) {
@@ -713,8 +743,8 @@ std::string describe(const Product& product, const Violation& v) {
   char depth[32];
   std::snprintf(depth, sizeof depth, "%.2f mm", v.depth * 1000);
   const bool part = v.member != "finger" && v.member != "palm" && v.member != "carriage";
-  return "step " + std::to_string(v.step) + ": the " + (part ? v.member : "gripper's " + v.member) + " went " +
-         (v.depth > 0 ? std::string(depth) + " into " : "through the open surface of ") + v.with + " while " + v.phase;
+  return "step " + std::to_string(v.step) + ": the " + (part ? v.member : "gripper's " + v.member) + " went " + depth +
+         (v.open_surface ? " through an open surface of " : " into ") + v.with + " while " + v.phase;
 }
 
 Verification verify_plan(const LoadedProduct& product, const Plan& plan, const VerifyOptions& options) {

@@ -41,6 +41,9 @@ struct Violation {
   double depth = 0;      // m, the deepest point found
   Vec3 where = Vec3::Zero();  // that point, in the product's frame
   std::string falls;          // or, after the step, what would not stand (stability.hpp's describe)
+  // The depth is how far a surface reached through a mesh that is not closed (it has no
+  // inside to measure): through one or the other.
+  bool open_surface = false;
 };
 
 struct Verification {
