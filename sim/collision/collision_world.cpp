@@ -300,10 +300,14 @@ btScalar begins_at(const btConvexShape* piece, const btTransform& at, const btVe
   return box_begins_at(lo, hi, axis);
 }
 
-// Whether two triangles of two meshes, where they stand, cross: they meet, and not only in
-// one plane (two faces resting on each other meet in their plane without crossing).
-bool crossing_triangles(const TriangleMesh& a, std::size_t ta, const Pose& pa, const TriangleMesh& b, std::size_t tb,
-                        const Pose& pb) {
+// Whether a triangle of one solid meets one of another where either may reach into the other:
+// they meet, and each has a corner behind the other's plane. One lying wholly on the outer
+// side of the other's plane (a wall standing on a floor, a block flush against a wall) only
+// touches it there, and searching the pair along the surface finds nothing, slowly; a part
+// that goes into the other crosses its surface elsewhere. `orientation_*`: the solids'
+// (Solid::orientation: -1 where the faces are wound inwards).
+bool meet_inside(const TriangleMesh& a, std::size_t ta, const Pose& pa, double orientation_a, const TriangleMesh& b,
+                 std::size_t tb, const Pose& pb, double orientation_b) {
   if (ta >= a.triangles.size() || tb >= b.triangles.size()) return false;
   const auto corners = [](const TriangleMesh& m, std::size_t t, const Pose& p) {
     return std::array<Eigen::Vector3d, 3>{p * m.vertices[m.triangles[t][0]], p * m.vertices[m.triangles[t][1]],
@@ -313,8 +317,11 @@ bool crossing_triangles(const TriangleMesh& a, std::size_t ta, const Pose& pa, c
   const Eigen::Vector3d nx = (x[1] - x[0]).cross(x[2] - x[0]), ny = (y[1] - y[0]).cross(y[2] - y[0]);
   if (nx.squaredNorm() == 0 || ny.squaredNorm() == 0) return false;
   constexpr double kInPlane = 1e-9;  // m
-  const Eigen::Vector3d ux = nx.normalized();
-  if (ux.cross(ny.normalized()).norm() < 1e-9 && std::abs(ux.dot(y[0] - x[0])) < kInPlane) return false;
+  const auto behind = [](const std::array<Eigen::Vector3d, 3>& t, const Eigen::Vector3d& outwards,
+                         const Eigen::Vector3d& on_plane) {
+    return std::any_of(t.begin(), t.end(), [&](const Eigen::Vector3d& c) { return outwards.dot(c - on_plane) < -kInPlane; });
+  };
+  if (!behind(x, orientation_b * ny.normalized(), y[0]) || !behind(y, orientation_a * nx.normalized(), x[0])) return false;
   const auto point = [](const Eigen::Vector3d& v) { return SolidPoint(v.x(), v.y(), v.z()); };
   return CGAL::do_intersect(SolidKernel::Triangle_3(point(x[0]), point(x[1]), point(x[2])),
                             SolidKernel::Triangle_3(point(y[0]), point(y[1]), point(y[2])));
@@ -723,22 +730,23 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
       const TriangleMesh& fixed_mesh = *impl_->meshes.at(fixed.mesh).mesh;
       const Pose member_pose = pose * moving.offset_of_child[child];
       const std::string& member = moving.coarse.member_of_child[child];
-      // Only triangles that cross: one that goes deep into the other's volume crosses its
-      // surface somewhere, and a pair that only touches (a face resting on a face, a tenon
-      // 0.04 mm clear in its mortise) would be searched over its whole area for nothing.
-      if (!crossing_triangles(moving_mesh, static_cast<std::size_t>(triangle), member_pose, fixed_mesh,
-                              static_cast<std::size_t>(crossing.triangle), fixed.pose)) {
+      // Only triangles that meet where one may reach into the other (meet_inside): a pair
+      // that only touches (a face resting on a face, a wall standing on a floor, a tenon
+      // 0.04 mm clear in its mortise) would be searched along the surface for nothing.
+      const Solid& fixed_solid = impl_->solid_of_body(fixed);
+      const Solid& moving_solid = moving.solid(child);
+      if (!meet_inside(moving_mesh, static_cast<std::size_t>(triangle), member_pose, moving_solid.orientation, fixed_mesh,
+                       static_cast<std::size_t>(crossing.triangle), fixed.pose, fixed_solid.orientation)) {
         continue;
       }
-      if (moving_done.insert({child, triangle}).second && static_cast<std::size_t>(triangle) < moving_mesh.triangles.size()) {
-        if (auto hit = deep_in(impl_->solid_of_body(fixed), moving_mesh, static_cast<std::size_t>(triangle),
-                               fixed.pose.inverse() * member_pose, member_pose, crossing.body, member)) {
+      if (moving_done.insert({child, triangle}).second) {
+        if (auto hit = deep_in(fixed_solid, moving_mesh, static_cast<std::size_t>(triangle), fixed.pose.inverse() * member_pose,
+                               member_pose, crossing.body, member)) {
           return hit;
         }
       }
-      if (static_done.insert({crossing.triangle, child}).second && crossing.triangle >= 0 &&
-          static_cast<std::size_t>(crossing.triangle) < fixed_mesh.triangles.size()) {
-        if (auto hit = deep_in(moving.solid(child), fixed_mesh, static_cast<std::size_t>(crossing.triangle),
+      if (static_done.insert({crossing.triangle, child}).second) {
+        if (auto hit = deep_in(moving_solid, fixed_mesh, static_cast<std::size_t>(crossing.triangle),
                                member_pose.inverse() * fixed.pose, fixed.pose, crossing.body, member)) {
           return hit;
         }

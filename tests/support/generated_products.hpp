@@ -105,7 +105,9 @@ inline sim::TriangleMesh beam_with_holes(double length, double height, double de
     cells.push_back({xc - half, xc + half, xc, hx, hz});
   }
   xs.push_back(L);
-  for (const auto& [y, up] : {std::pair{height, true}, std::pair{0.0, false}}) {
+  for (const auto& side : {std::pair{height, true}, std::pair{0.0, false}}) {
+    const double y = side.first;
+    const bool up = side.second;  // a structured binding cannot be captured before C++20
     const auto face = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
       if (up) {
         quad(a, b, c, d);

@@ -109,8 +109,8 @@ class InMemoryDescription : public twin::ProductDescription {
   std::string product_name() const override { return "pair"; }
   std::filesystem::path source() const override { return "memory"; }
   std::vector<twin::DescriptionItem> items() const override {
-    twin::ParameterItem socket{"Base", "socket", twin::Frame{Vec3(0, 0.01, 0), twin::Quat::Identity()}, {}};
-    twin::ParameterItem pin{"Pin", "end", twin::Frame{Vec3(0, -0.002, 0), twin::Quat::Identity()}, {}};
+    twin::ParameterItem socket{"Base", "socket", twin::Frame{Vec3(0, 0.01, 0), twin::Quat::Identity()}, {}, {}};
+    twin::ParameterItem pin{"Pin", "end", twin::Frame{Vec3(0, -0.002, 0), twin::Quat::Identity()}, {}, {}};
     twin::CreatePartItem base;
     base.id = "b";
     base.name = "base";

@@ -534,13 +534,14 @@ void verify(const LoadedProduct& product, Plan& plan, const PlannerOptions& opti
 
 // Where no order stands, the order that goes together without gravity, with the steps after
 // which something would fall named: a fixture must hold it. Complete only for a cell that has
-// fixtures (PlannerOptions::fixtures).
-std::optional<Plan> plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
-                                       const PlannerOptions& options, const StabilityAnalysis& stability) {
+// fixtures (PlannerOptions::fixtures) and only if every part goes in; a partial plan still
+// tells the designer more than one that stopped at the first part that would fall.
+Plan plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
+                        const PlannerOptions& options, const StabilityAnalysis& stability, double time_limit) {
   PlannerOptions loose = options;
   loose.stability = false;
+  loose.time_limit = time_limit;
   Plan plan = Search(product, sequence, path, loose, nullptr).run();
-  if (!plan.complete) return std::nullopt;
   const auto& connections = product.product.connections();
   std::vector<PlacedPart> placed;
   std::vector<PartIndex> held;  // by fixtures, from the step that needs them on
@@ -568,7 +569,7 @@ std::optional<Plan> plan_with_fixtures(const LoadedProduct& product, SequencePla
     plan.steps[i].hold = before != fastened && stability.check(placed, held, before).has_value();
   }
   plan.stability = options.stability;
-  plan.complete = options.fixtures;
+  plan.complete = plan.complete && options.fixtures;
   return plan;
 }
 
@@ -583,10 +584,14 @@ Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, Path
     if (!options.given.empty()) throw std::logic_error("planning on from given steps of a product with subassemblies");
     plan = plan_with_subassemblies(product, sequence, path, options);
   } else {
+    const auto start = std::chrono::steady_clock::now();
     Search search(product, sequence, path, options, &stability);
     plan = search.run();
-    if (!plan.complete && search.refused_for_gravity()) {
-      if (auto fixtures = plan_with_fixtures(product, sequence, path, options, stability)) plan = std::move(*fixtures);
+    const double left =
+        options.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!plan.complete && search.refused_for_gravity() && (options.time_limit <= 0 || left > 0)) {
+      Plan fixtures = plan_with_fixtures(product, sequence, path, options, stability, options.time_limit <= 0 ? 0 : left);
+      if (fixtures.complete || fixtures.steps.size() > plan.steps.size()) plan = std::move(fixtures);
     }
   }
   plan.stability = options.stability;
