@@ -305,9 +305,11 @@ btScalar begins_at(const btConvexShape* piece, const btTransform& at, const btVe
 // side of the other's plane (a wall standing on a floor, a block flush against a wall) only
 // touches it there, and searching the pair along the surface finds nothing, slowly; a part
 // that goes into the other crosses its surface elsewhere. `orientation_*`: the solids'
-// (Solid::orientation: -1 where the faces are wound inwards).
-bool meet_inside(const TriangleMesh& a, std::size_t ta, const Pose& pa, double orientation_a, const TriangleMesh& b,
-                 std::size_t tb, const Pose& pb, double orientation_b) {
+// (Solid::orientation: -1 where the faces are wound inwards), asked only of triangles that
+// meet: a solid is made on first use.
+template <class OrientationA, class OrientationB>
+bool meet_inside(const TriangleMesh& a, std::size_t ta, const Pose& pa, const OrientationA& orientation_a,
+                 const TriangleMesh& b, std::size_t tb, const Pose& pb, const OrientationB& orientation_b) {
   if (ta >= a.triangles.size() || tb >= b.triangles.size()) return false;
   const auto corners = [](const TriangleMesh& m, std::size_t t, const Pose& p) {
     return std::array<Eigen::Vector3d, 3>{p * m.vertices[m.triangles[t][0]], p * m.vertices[m.triangles[t][1]],
@@ -321,10 +323,10 @@ bool meet_inside(const TriangleMesh& a, std::size_t ta, const Pose& pa, double o
                          const Eigen::Vector3d& on_plane) {
     return std::any_of(t.begin(), t.end(), [&](const Eigen::Vector3d& c) { return outwards.dot(c - on_plane) < -kInPlane; });
   };
-  if (!behind(x, orientation_b * ny.normalized(), y[0]) || !behind(y, orientation_a * nx.normalized(), x[0])) return false;
   const auto point = [](const Eigen::Vector3d& v) { return SolidPoint(v.x(), v.y(), v.z()); };
   return CGAL::do_intersect(SolidKernel::Triangle_3(point(x[0]), point(x[1]), point(x[2])),
-                            SolidKernel::Triangle_3(point(y[0]), point(y[1]), point(y[2])));
+                            SolidKernel::Triangle_3(point(y[0]), point(y[1]), point(y[2]))) &&
+         behind(x, orientation_b() * ny.normalized(), y[0]) && behind(y, orientation_a() * nx.normalized(), x[0]);
 }
 
 // The children of a compound whose boxes overlap a box in its frame.
@@ -733,20 +735,21 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
       // Only triangles that meet where one may reach into the other (meet_inside): a pair
       // that only touches (a face resting on a face, a wall standing on a floor, a tenon
       // 0.04 mm clear in its mortise) would be searched along the surface for nothing.
-      const Solid& fixed_solid = impl_->solid_of_body(fixed);
-      const Solid& moving_solid = moving.solid(child);
-      if (!meet_inside(moving_mesh, static_cast<std::size_t>(triangle), member_pose, moving_solid.orientation, fixed_mesh,
-                       static_cast<std::size_t>(crossing.triangle), fixed.pose, fixed_solid.orientation)) {
+      const auto moving_solid = [&]() -> const Solid& { return moving.solid(child); };
+      const auto fixed_solid = [&]() -> const Solid& { return impl_->solid_of_body(fixed); };
+      if (!meet_inside(moving_mesh, static_cast<std::size_t>(triangle), member_pose, [&] { return moving_solid().orientation; },
+                       fixed_mesh, static_cast<std::size_t>(crossing.triangle), fixed.pose,
+                       [&] { return fixed_solid().orientation; })) {
         continue;
       }
       if (moving_done.insert({child, triangle}).second) {
-        if (auto hit = deep_in(fixed_solid, moving_mesh, static_cast<std::size_t>(triangle), fixed.pose.inverse() * member_pose,
+        if (auto hit = deep_in(fixed_solid(), moving_mesh, static_cast<std::size_t>(triangle), fixed.pose.inverse() * member_pose,
                                member_pose, crossing.body, member)) {
           return hit;
         }
       }
       if (static_done.insert({crossing.triangle, child}).second) {
-        if (auto hit = deep_in(moving_solid, fixed_mesh, static_cast<std::size_t>(crossing.triangle),
+        if (auto hit = deep_in(moving_solid(), fixed_mesh, static_cast<std::size_t>(crossing.triangle),
                                member_pose.inverse() * fixed.pose, fixed.pose, crossing.body, member)) {
           return hit;
         }

@@ -59,9 +59,10 @@ TEST_CASE("generated products: posts with tenons in beams, every plan agrees wit
   const std::uint32_t count = 1000 / kScale;
   for (std::uint32_t seed = 1; seed <= count; ++seed) check(test::posts_and_beams(seed), tally);
   INFO(tally.complete << " complete, " << tally.refused << " refused");
-  // Neither side empty: the products are made to come out both ways.
+  // Neither side empty: the products are made to come out both ways (more than 1 of the 25
+  // made under the sanitizers, more than 40 of the 1000 in Release).
   CHECK(tally.complete > count / 4);
-  CHECK(tally.refused > count / 10);
+  CHECK(tally.refused > count / 25);
 }
 
 TEST_CASE("generated products: stacked blocks, every plan agrees with its replay", "[planning][generated]") {
@@ -70,5 +71,5 @@ TEST_CASE("generated products: stacked blocks, every plan agrees with its replay
   for (std::uint32_t seed = 1; seed <= count; ++seed) check(test::stacked_blocks(seed), tally);
   INFO(tally.complete << " complete, " << tally.refused << " refused");
   CHECK(tally.complete > count / 4);
-  CHECK(tally.refused > count / 10);
+  CHECK(tally.refused > count / 25);
 }
