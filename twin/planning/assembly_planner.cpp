@@ -569,7 +569,9 @@ Plan plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence,
     plan.steps[i].hold = before != fastened && stability.check(placed, held, before).has_value();
   }
   plan.stability = options.stability;
-  plan.complete = plan.complete && options.fixtures;
+  // An order that needs no fixture after all stands as it is.
+  const bool fixed = std::any_of(plan.steps.begin(), plan.steps.end(), [](const PlanStep& s) { return !s.fixture.empty(); });
+  plan.complete = plan.complete && (options.fixtures || !fixed);
   return plan;
 }
 
