@@ -725,7 +725,9 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
           body_it == impl_->bodies.end() || !body_it->second.mesh) {
         continue;
       }
-      const auto [child, triangle] = moving.origin_of_exact_child[static_cast<std::size_t>(crossing.self_child)];
+      const auto& origin = moving.origin_of_exact_child[static_cast<std::size_t>(crossing.self_child)];
+      const std::size_t child = origin.first;  // not a structured binding: the lambdas below capture it
+      const int triangle = origin.second;
       if (triangle < 0 || !moving.mesh_of_child[child]) continue;
       const Impl::Body& fixed = body_it->second;
       const TriangleMesh& moving_mesh = *moving.mesh_of_child[child];
