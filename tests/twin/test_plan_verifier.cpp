@@ -44,8 +44,11 @@ TEST_CASE("verification: a base beam lowered over posts that stand where it goes
   // beam's mortises. Stood on the station first, they are where the base must come down.
   const auto product = test::load(real("asap-beam-frame/asap-beam-frame.aml"));
   const twin::Plan posts_first = unchecked_plan(product, {"post_left", "post_right", "base", "beam_left", "beam_right"});
-  // Under gravity the first post would already topple where it stands, on its tenon.
-  const twin::Verification toppling = twin::verify_plan(product, posts_first);
+  // Under gravity the first post would already topple where it stands, on its tenon (its
+  // step alone is replayed: the rest of the plan is the geometry's, below).
+  twin::Plan first_post = posts_first;
+  first_post.steps.resize(1);
+  const twin::Verification toppling = twin::verify_plan(product, first_post);
   REQUIRE_FALSE(toppling.violations.empty());
   CHECK(toppling.violations.front().step == 1);
   CHECK(toppling.violations.front().falls.find("post_left: it would topple") == 0);
@@ -68,7 +71,6 @@ TEST_CASE("verification: a base beam lowered over posts that stand where it goes
   CHECK(product.product.parts()[planned.plan.steps.front().part].name == "base");
   CHECK(planned.plan.verification.run);
   CHECK(planned.plan.verification.passed);
-  CHECK(twin::verify_plan(planned.product, planned.plan).verified);
 }
 
 TEST_CASE("verification: the search does not go on from a base lowered over its posts", "[verify][planning]") {
