@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -177,14 +178,13 @@ std::optional<bool> stack_stands(const twin::LoadedProduct& stack) {
 }
 
 struct Cases {
-  std::vector<twin::LoadedProduct> products;
+  std::deque<twin::LoadedProduct> products;  // a deque: the cases point into it as it grows
   std::vector<Case> cases;
 };
 
 const Cases& stacks() {
   static const Cases made = [] {
     Cases out;
-    out.products.reserve(400);
     for (std::uint32_t seed = 1; out.products.size() < 400 && seed < 2000; ++seed) {
       auto generated = test::stacked_blocks(seed);
       const auto truth = stack_stands(generated.product);
@@ -192,9 +192,8 @@ const Cases& stacks() {
       out.products.push_back(std::move(generated.product));
       std::vector<twin::PartIndex> all(out.products.back().product.parts().size());
       for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-      out.cases.push_back({nullptr, all, *truth});
+      out.cases.push_back({&out.products.back(), all, *truth});
     }
-    for (std::size_t i = 0; i < out.cases.size(); ++i) out.cases[i].product = &out.products[i];
     return out;
   }();
   return made;
@@ -203,7 +202,6 @@ const Cases& stacks() {
 const Cases& posts() {
   static const Cases made = [] {
     Cases out;
-    out.products.reserve(100);
     for (std::uint32_t seed = 1; out.products.size() < 100; ++seed) {
       auto generated = test::posts_and_beams(seed);
       if (generated.expect != test::Expect::buildable) continue;
@@ -213,9 +211,8 @@ const Cases& posts() {
         const std::string& name = out.products.back().product.parts()[i].name;
         if (name == "base" || name.rfind("post", 0) == 0) base_and_posts.push_back(i);
       }
-      out.cases.push_back({nullptr, base_and_posts, true});
+      out.cases.push_back({&out.products.back(), base_and_posts, true});
     }
-    for (std::size_t i = 0; i < out.cases.size(); ++i) out.cases[i].product = &out.products[i];
     return out;
   }();
   return made;
