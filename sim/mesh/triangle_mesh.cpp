@@ -18,6 +18,8 @@
 namespace sim {
 namespace {
 
+using EdgeUsers = std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>>;  // undirected edge -> triangles
+
 bool has_edge(const std::array<std::uint32_t, 3>& t, std::uint32_t a, std::uint32_t b) {
   for (int k = 0; k < 3; ++k) {
     if (t[k] == a && t[(k + 1) % 3] == b) return true;
@@ -28,8 +30,7 @@ bool has_edge(const std::array<std::uint32_t, 3>& t, std::uint32_t a, std::uint3
 // Winds each connected piece one way, outwards (a CAD export may flip some normals): a
 // triangle wound like its neighbour across a shared edge is turned over, and a closed piece
 // whose volume comes out negative is turned inside out. Counts the triangles turned.
-void orient(TriangleMesh& mesh,
-            const std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>>& edges) {
+void orient(TriangleMesh& mesh, const EdgeUsers& edges) {
   auto& tris = mesh.triangles;
   std::vector<bool> seen(tris.size(), false), turned(tris.size(), false);
   const auto turn = [&](std::size_t i) {
@@ -121,8 +122,78 @@ void join_pieces(TriangleMesh& mesh) {
   for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) mesh.pieces.front().push_back(v);
 }
 
-// Drops degenerate and duplicate triangles; counts open and non-manifold edges; winds the
-// triangles outwards.
+EdgeUsers edge_users(const TriangleMesh& mesh) {
+  EdgeUsers edges;
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const auto& t = mesh.triangles[i];
+    for (int k = 0; k < 3; ++k) edges[std::minmax(t[k], t[(k + 1) % 3])].push_back(i);
+  }
+  return edges;
+}
+
+// Splits each open edge at the corners of other open edges that lie on it. A CAD export that
+// meshes two faces apart may run one face's edge whole past a corner where the other face's
+// edge is split (a T-junction): the mesh looks open where it is closed (a pulley: 3 open
+// edges, so no inside to measure an overlap by). The surface stays as it was. Returns how many
+// edges were split.
+std::size_t split_at_t_junctions(TriangleMesh& mesh, const EdgeUsers& edges) {
+  std::vector<std::uint32_t> loose;  // the corners of open edges, by x
+  for (const auto& [edge, users] : edges) {
+    if (users.size() != 1) continue;
+    loose.push_back(edge.first);
+    loose.push_back(edge.second);
+  }
+  if (loose.empty()) return 0;
+  const auto x_of = [&](std::uint32_t v) { return mesh.vertices[v].x(); };
+  std::sort(loose.begin(), loose.end());
+  loose.erase(std::unique(loose.begin(), loose.end()), loose.end());
+  std::sort(loose.begin(), loose.end(), [&](std::uint32_t u, std::uint32_t v) { return x_of(u) < x_of(v); });
+
+  std::vector<bool> replaced(mesh.triangles.size(), false);
+  std::vector<std::array<std::uint32_t, 3>> added;
+  std::size_t split = 0;
+  for (const auto& [edge, users] : edges) {
+    if (users.size() != 1 || replaced[users[0]]) continue;
+    const auto& t = mesh.triangles[users[0]];
+    int k = 0;
+    while (std::pair<std::uint32_t, std::uint32_t>(std::minmax(t[k], t[(k + 1) % 3])) != edge) ++k;
+    const std::uint32_t a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+    const Eigen::Vector3d &pa = mesh.vertices[a], &pb = mesh.vertices[b];
+    const Eigen::Vector3d ab = pb - pa;
+    const double length2 = ab.squaredNorm();
+    const double tolerance = 1e-6 * std::sqrt(length2);  // a float's rounding of CAD coordinates, with room
+    const auto first = std::lower_bound(loose.begin(), loose.end(), std::min(pa.x(), pb.x()) - tolerance,
+                                        [&](std::uint32_t v, double x) { return x_of(v) < x; });
+    std::vector<std::pair<double, std::uint32_t>> on;  // corners on the edge, by their place along it
+    for (auto it = first; it != loose.end() && x_of(*it) <= std::max(pa.x(), pb.x()) + tolerance; ++it) {
+      const Eigen::Vector3d& p = mesh.vertices[*it];
+      const double along = (p - pa).dot(ab) / length2;
+      if (along <= 1e-6 || along >= 1 - 1e-6 || (pa + along * ab - p).norm() > tolerance) continue;
+      on.emplace_back(along, *it);
+    }
+    if (on.empty()) continue;
+    std::sort(on.begin(), on.end());
+    replaced[users[0]] = true;
+    ++split;
+    std::uint32_t from = a;  // a fan from c, wound as the triangle was
+    for (const auto& [along, v] : on) {
+      added.push_back({from, v, c});
+      from = v;
+    }
+    added.push_back({from, b, c});
+  }
+  if (split == 0) return 0;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (!replaced[i]) mesh.triangles[kept++] = mesh.triangles[i];
+  }
+  mesh.triangles.resize(kept);
+  mesh.triangles.insert(mesh.triangles.end(), added.begin(), added.end());
+  return split;
+}
+
+// Drops degenerate and duplicate triangles; splits edges at T-junctions; counts open and
+// non-manifold edges; winds the triangles outwards.
 void repair(TriangleMesh& mesh) {
   using Corners = std::array<std::uint32_t, 3>;
   std::set<Corners> seen;
@@ -144,11 +215,9 @@ void repair(TriangleMesh& mesh) {
     kept.push_back(t);
   }
   mesh.triangles = std::move(kept);
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>> edges;  // undirected edge -> triangles
-  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-    const auto& t = mesh.triangles[i];
-    for (int k = 0; k < 3; ++k) edges[std::minmax(t[k], t[(k + 1) % 3])].push_back(i);
-  }
+  EdgeUsers edges = edge_users(mesh);
+  mesh.repairs.t_junctions = split_at_t_junctions(mesh, edges);
+  if (mesh.repairs.t_junctions > 0) edges = edge_users(mesh);
   for (const auto& [edge, users] : edges) {
     if (users.size() == 1) ++mesh.repairs.open_edges;
     if (users.size() > 2) ++mesh.repairs.non_manifold_edges;
@@ -247,6 +316,8 @@ std::string TriangleMesh::Repairs::describe() const {
   say(duplicate, "duplicate triangle dropped", "duplicate triangles dropped");
   say(flipped, "triangle turned to face outwards (its normal was flipped)",
       "triangles turned to face outwards (their normals were flipped)");
+  say(t_junctions, "edge split at a corner that lay on it (a T-junction)",
+      "edges split at corners that lay on them (T-junctions)");
   say(open_edges, "open edge (the mesh is not closed)", "open edges (the mesh is not closed)");
   say(non_manifold_edges, "edge shared by more than two triangles", "edges shared by more than two triangles");
   std::string out;

@@ -95,6 +95,23 @@ TEST_CASE("a careless export: degenerate and duplicate triangles are dropped, op
   CHECK_FALSE(sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3)->repairs.any());
 }
 
+TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split there, and the mesh is closed",
+          "[mesh][repairs]") {
+  const auto block = sim::load_mesh(data("planning/messy/meshes/t_junction_block_mm.obj"), 1e-3);
+  CHECK(block->repairs.t_junctions == 2);
+  CHECK(block->repairs.open_edges == 0);
+  CHECK(block->triangles.size() == 16);  // the front's and back's top triangles split in two
+  double volume = 0;
+  for (const auto& t : block->triangles) {
+    volume += block->vertices[t[0]].dot(block->vertices[t[1]].cross(block->vertices[t[2]])) / 6;
+  }
+  CHECK(volume == Approx(8e-6));  // the same cube, outwards
+  CHECK(block->convex);
+  CHECK(block->repairs.describe() == "2 edges split at corners that lay on them (T-junctions)");
+  // An open edge with no corner on it stays open.
+  CHECK(sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3)->repairs.t_junctions == 0);
+}
+
 TEST_CASE("an edge shared by more than two triangles is counted and said", "[mesh][repairs]") {
   const auto fins = sim::load_mesh(data("planning/messy/meshes/fins_mm.obj"), 1e-3);
   CHECK(fins->triangles.size() == 3);
