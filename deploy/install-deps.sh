@@ -19,6 +19,7 @@ packages=(
   libassimp-dev libtinygltf-dev libcli11-dev nlohmann-json3-dev libyaml-cpp-dev
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev
   libsqlite3-dev sqlite3
+  nettle-dev     # SHA-256 of the mesh cache's keys, base64 (light to load: cellctl plan's start)
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
 )

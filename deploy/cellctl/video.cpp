@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <openssl/evp.h>
+#include <nettle/base64.h>
 
 #include "deploy/cellctl/processes.hpp"
 
@@ -48,13 +48,15 @@ std::string tail(const std::string& text, std::size_t n = 600) {
 }
 
 std::string decode_base64(const std::string& text) {
-  std::string out(text.size() / 4 * 3 + 3, '\0');
-  const int n = EVP_DecodeBlock(reinterpret_cast<unsigned char*>(out.data()),
-                                reinterpret_cast<const unsigned char*>(text.data()), static_cast<int>(text.size()));
-  if (n < 0) throw std::runtime_error("chromium gave a frame that is not base64");
-  std::size_t padding = 0;
-  for (auto it = text.rbegin(); it != text.rend() && *it == '='; ++it) ++padding;
-  out.resize(static_cast<std::size_t>(n) - padding);
+  base64_decode_ctx context;
+  base64_decode_init(&context);
+  std::string out(BASE64_DECODE_LENGTH(text.size()), '\0');
+  std::size_t length = out.size();
+  if (!base64_decode_update(&context, &length, reinterpret_cast<std::uint8_t*>(out.data()), text.size(), text.data()) ||
+      !base64_decode_final(&context)) {
+    throw std::runtime_error("chromium gave a frame that is not base64");
+  }
+  out.resize(length);
   return out;
 }
 

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include <openssl/evp.h>
+#include <nettle/sha2.h>
 
 namespace sim {
 namespace {
@@ -25,19 +25,16 @@ constexpr std::uint32_t kVersion = 10;  // 4: the triangle tree (TriangleMesh::b
 // OEMs (the order desk): with a hash one can collide on purpose (FNV-1a was used before), a
 // crafted file could stand in for another client's cached mesh.
 std::string content_hash(const std::string& bytes, const std::string& extension) {
-  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1 ||
-      EVP_DigestUpdate(context.get(), bytes.data(), bytes.size()) != 1 ||
-      EVP_DigestUpdate(context.get(), "\0", 1) != 1 ||
-      EVP_DigestUpdate(context.get(), extension.data(), extension.size()) != 1 ||
-      EVP_DigestFinal_ex(context.get(), digest, &length) != 1) {
-    throw std::runtime_error("SHA-256 failed");
-  }
+  sha256_ctx context;
+  sha256_init(&context);
+  sha256_update(&context, bytes.size(), reinterpret_cast<const std::uint8_t*>(bytes.data()));
+  sha256_update(&context, 1, reinterpret_cast<const std::uint8_t*>("\0"));
+  sha256_update(&context, extension.size(), reinterpret_cast<const std::uint8_t*>(extension.data()));
+  std::uint8_t digest[SHA256_DIGEST_SIZE];
+  sha256_digest(&context, SHA256_DIGEST_SIZE, digest);
   static const char* const hex = "0123456789abcdef";
   std::string out;
-  for (unsigned int i = 0; i < length; ++i) out += {hex[digest[i] >> 4], hex[digest[i] & 15]};
+  for (const std::uint8_t byte : digest) out += {hex[byte >> 4], hex[byte & 15]};
   return out;
 }
 
