@@ -110,6 +110,11 @@ TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split the
   CHECK(block->repairs.describe() == "2 edges split at corners that lay on them (T-junctions)");
   // An open edge with no corner on it stays open.
   CHECK(sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3)->repairs.t_junctions == 0);
+  // A real one: FurnitureBench's cabinet door (tests/data/real), three bodies welded into one,
+  // read as 24 open edges before.
+  const auto door = sim::load_mesh(std::filesystem::path(REAL_DATA_DIR) / "fb-cabinet/meshes/cabinet_door_right.obj");
+  CHECK(door->repairs.t_junctions == 8);
+  CHECK(door->repairs.open_edges == 0);
 }
 
 TEST_CASE("an edge shared by more than two triangles is counted and said", "[mesh][repairs]") {
