@@ -152,7 +152,11 @@ std::size_t split_at_t_junctions(TriangleMesh& mesh, const EdgeUsers& edges) {
   std::vector<bool> replaced(mesh.triangles.size(), false);
   std::vector<std::array<std::uint32_t, 3>> added;
   std::size_t split = 0;
+  // Corners looked at, at most: a hostile file whose open corners share one x would otherwise
+  // cost their number squared. What is left unsplit stays open, and is said to be.
+  std::size_t budget = 64 * loose.size() + 1'000'000;
   for (const auto& [edge, users] : edges) {
+    if (budget == 0) break;
     if (users.size() != 1 || replaced[users[0]]) continue;
     const auto& t = mesh.triangles[users[0]];
     int k = 0;
@@ -165,7 +169,8 @@ std::size_t split_at_t_junctions(TriangleMesh& mesh, const EdgeUsers& edges) {
     const auto first = std::lower_bound(loose.begin(), loose.end(), std::min(pa.x(), pb.x()) - tolerance,
                                         [&](std::uint32_t v, double x) { return x_of(v) < x; });
     std::vector<std::pair<double, std::uint32_t>> on;  // corners on the edge, by their place along it
-    for (auto it = first; it != loose.end() && x_of(*it) <= std::max(pa.x(), pb.x()) + tolerance; ++it) {
+    for (auto it = first; it != loose.end() && x_of(*it) <= std::max(pa.x(), pb.x()) + tolerance && budget > 0;
+         ++it, --budget) {
       const Eigen::Vector3d& p = mesh.vertices[*it];
       const double along = (p - pa).dot(ab) / length2;
       if (along <= 1e-6 || along >= 1 - 1e-6 || (pa + along * ab - p).norm() > tolerance) continue;

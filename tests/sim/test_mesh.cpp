@@ -117,6 +117,24 @@ TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split the
   CHECK(door->repairs.open_edges == 0);
 }
 
+TEST_CASE("T-junctions: a file of many open corners in one plane is read in bounded time, left open", "[mesh][repairs]") {
+  // 20 000 loose triangles at x = 0: every open edge's corners share its x, so looking for
+  // corners on each edge by x alone would be 60 000 squared checks.
+  const auto file = std::filesystem::temp_directory_path() / ("loose-" + std::to_string(::getpid()) + ".obj");
+  {
+    std::ofstream out(file);
+    for (int i = 0; i < 20000; ++i) {
+      const double y = (i % 200) * 2e-3, z = (i / 200) * 2e-3;
+      out << "v 0 " << y << ' ' << z << "\nv 0 " << y + 1e-3 << ' ' << z << "\nv 0 " << y << ' ' << z + 1e-3 << '\n';
+    }
+    for (int i = 0; i < 20000; ++i) out << "f " << 3 * i + 1 << ' ' << 3 * i + 2 << ' ' << 3 * i + 3 << '\n';
+  }
+  const auto loose = sim::load_mesh(file, 1);
+  std::filesystem::remove(file);
+  CHECK(loose->repairs.open_edges == 60000);
+  CHECK(loose->repairs.t_junctions == 0);
+}
+
 TEST_CASE("an edge shared by more than two triangles is counted and said", "[mesh][repairs]") {
   const auto fins = sim::load_mesh(data("planning/messy/meshes/fins_mm.obj"), 1e-3);
   CHECK(fins->triangles.size() == 3);
