@@ -19,7 +19,7 @@ namespace {
 
 constexpr std::uint64_t kMagic = 0x31687365'4d6c6c65ULL;  // "ellMesh1"
 // Raise it whenever loading gives other meshes (a new repair): older entries are then ignored.
-constexpr std::uint32_t kVersion = 10;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept; 6: convex meshes' coarse hulls; 7: coarse margins measured exactly (6 could hold 3e35 m); 8: objects joined where they are not convex pieces; 9: corners welded by position alone; 10: edges split at T-junctions
+constexpr std::uint32_t kVersion = 11;  // 4: the triangle tree (TriangleMesh::bvh_nodes); 5: COLLADA up axis kept; 6: convex meshes' coarse hulls; 7: coarse margins measured exactly (6 could hold 3e35 m); 8: objects joined where they are not convex pieces; 9: corners welded by position alone; 10: edges split at T-junctions; 11: missing triangles filled
 
 // SHA-256 of the file's bytes, a NUL, then its extension (how it is read), in hex. Meshes come from
 // OEMs (the order desk): with a hash one can collide on purpose (FNV-1a was used before), a
@@ -79,7 +79,8 @@ void write_entry(const std::filesystem::path& path, const TriangleMesh& m) {
     put(out, m.bounds.min());
     put(out, m.bounds.max());
     put(out, static_cast<std::uint8_t>(m.convex));
-    for (std::size_t n : {m.repairs.degenerate, m.repairs.duplicate, m.repairs.flipped, m.repairs.t_junctions, m.repairs.open_edges,
+    for (std::size_t n : {m.repairs.degenerate, m.repairs.duplicate, m.repairs.flipped, m.repairs.t_junctions, m.repairs.missing_triangles,
+                          m.repairs.open_edges,
                           m.repairs.non_manifold_edges, m.repairs.joined_objects}) {
       put(out, static_cast<std::uint64_t>(n));
     }
@@ -137,7 +138,8 @@ std::shared_ptr<TriangleMesh> read_entry(const std::filesystem::path& path) {
   if (!get(in, lo) || !get(in, hi) || !get(in, convex)) return nullptr;
   m->bounds = Eigen::AlignedBox3d(lo, hi);
   m->convex = convex != 0;
-  for (std::size_t* r : {&m->repairs.degenerate, &m->repairs.duplicate, &m->repairs.flipped, &m->repairs.t_junctions, &m->repairs.open_edges,
+  for (std::size_t* r : {&m->repairs.degenerate, &m->repairs.duplicate, &m->repairs.flipped, &m->repairs.t_junctions, &m->repairs.missing_triangles,
+                         &m->repairs.open_edges,
                          &m->repairs.non_manifold_edges, &m->repairs.joined_objects}) {
     if (!get(in, n)) return nullptr;
     *r = n;

@@ -197,8 +197,54 @@ std::size_t split_at_t_junctions(TriangleMesh& mesh, const EdgeUsers& edges) {
   return split;
 }
 
-// Drops degenerate and duplicate triangles; splits edges at T-junctions; counts open and
-// non-manifold edges; winds the triangles outwards.
+// Fills each hole of three open edges, of three triangles, with the triangle that is missing
+// (a CAD export that dropped one): the only surface that closes it. Holes of more edges are
+// left open (two rims of a bore whose wall is missing would be closed wrongly by two caps).
+// Returns how many were filled.
+std::size_t fill_missing_triangles(TriangleMesh& mesh, const EdgeUsers& edges) {
+  // Each open edge as its triangle runs it, by the corner it leaves.
+  std::multimap<std::uint32_t, std::pair<std::uint32_t, std::size_t>> out;  // from -> (to, triangle)
+  for (const auto& [edge, users] : edges) {
+    if (users.size() != 1) continue;
+    const auto& t = mesh.triangles[users[0]];
+    const bool forward = has_edge(t, edge.first, edge.second);
+    out.emplace(forward ? edge.first : edge.second, std::pair{forward ? edge.second : edge.first, users[0]});
+  }
+  std::set<std::pair<std::uint32_t, std::uint32_t>> filled;  // undirected edges closed
+  std::size_t count = 0;
+  std::size_t budget = 64 * out.size() + 1'000'000;  // pairs of edges looked at (a hostile fan)
+  for (const auto& entry : out) {
+    const std::uint32_t a = entry.first, b = entry.second.first;
+    const std::size_t t_ab = entry.second.second;
+    const auto [first, last] = out.equal_range(b);
+    for (auto bc = first; bc != last && budget > 0; ++bc, --budget) {
+      const std::uint32_t c = bc->second.first;
+      const std::size_t t_bc = bc->second.second;
+      const auto [from_c, end_c] = out.equal_range(c);
+      const bool closes = std::any_of(from_c, end_c, [&](const auto& ca) {
+        return ca.second.first == a && ca.second.second != t_ab && ca.second.second != t_bc;
+      });
+      if (!closes || t_ab == t_bc || filled.count(std::minmax(a, b)) || filled.count(std::minmax(b, c)) ||
+          filled.count(std::minmax(c, a))) {
+        continue;
+      }
+      const Eigen::Vector3d &pa = mesh.vertices[a], &pb = mesh.vertices[b], &pc = mesh.vertices[c];
+      if ((pb - pa).cross(pc - pa).squaredNorm() <= 1e-24 * std::pow((pb - pa).squaredNorm() + (pc - pa).squaredNorm(), 2)) {
+        continue;  // no area: nothing to fill
+      }
+      mesh.triangles.push_back({a, c, b});  // against the way its neighbours run the edges
+      filled.insert(std::minmax(a, b));
+      filled.insert(std::minmax(b, c));
+      filled.insert(std::minmax(c, a));
+      ++count;
+      break;
+    }
+  }
+  return count;
+}
+
+// Drops degenerate and duplicate triangles; splits edges at T-junctions; fills missing
+// triangles; counts open and non-manifold edges; winds the triangles outwards.
 void repair(TriangleMesh& mesh) {
   using Corners = std::array<std::uint32_t, 3>;
   std::set<Corners> seen;
@@ -223,6 +269,8 @@ void repair(TriangleMesh& mesh) {
   EdgeUsers edges = edge_users(mesh);
   mesh.repairs.t_junctions = split_at_t_junctions(mesh, edges);
   if (mesh.repairs.t_junctions > 0) edges = edge_users(mesh);
+  mesh.repairs.missing_triangles = fill_missing_triangles(mesh, edges);
+  if (mesh.repairs.missing_triangles > 0) edges = edge_users(mesh);
   for (const auto& [edge, users] : edges) {
     if (users.size() == 1) ++mesh.repairs.open_edges;
     if (users.size() > 2) ++mesh.repairs.non_manifold_edges;
@@ -323,6 +371,7 @@ std::string TriangleMesh::Repairs::describe() const {
       "triangles turned to face outwards (their normals were flipped)");
   say(t_junctions, "edge split at a corner that lay on it (a T-junction)",
       "edges split at corners that lay on them (T-junctions)");
+  say(missing_triangles, "missing triangle filled (a hole of three edges)", "missing triangles filled (holes of three edges)");
   say(open_edges, "open edge (the mesh is not closed)", "open edges (the mesh is not closed)");
   say(non_manifold_edges, "edge shared by more than two triangles", "edges shared by more than two triangles");
   std::string out;

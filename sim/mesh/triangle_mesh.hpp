@@ -47,17 +47,19 @@ struct TriangleMesh {
   // (a repeated corner, or no area) and duplicates (the same three corners) are dropped;
   // triangles wound against their neighbours, or a closed piece wound inside out, are turned
   // to face outwards (flipped); an open edge that other open edges' corners lie on is split
-  // there (t_junctions: the surface is the same, and closed); edges with one triangle (open)
+  // there (t_junctions: the surface is the same, and closed); a hole of three open edges is
+  // closed by the triangle missing there (missing_triangles); edges with one triangle (open)
   // or more than two (non-manifold) are counted.
   // A file's objects are taken as the convex pieces of a decomposition only where every one
   // of them closes a convex solid; where not (a CAD export that writes a face or a body per
   // object), the objects are joined into one piece, welded where their corners coincide, and
   // `joined_objects` says how many there were.
   struct Repairs {
-    std::size_t degenerate = 0, duplicate = 0, flipped = 0, t_junctions = 0, open_edges = 0, non_manifold_edges = 0;
-    std::size_t joined_objects = 0;
+    std::size_t degenerate = 0, duplicate = 0, flipped = 0, t_junctions = 0, missing_triangles = 0, open_edges = 0;
+    std::size_t non_manifold_edges = 0, joined_objects = 0;
     bool any() const {
-      return degenerate + duplicate + flipped + t_junctions + open_edges + non_manifold_edges + joined_objects > 0;
+      return degenerate + duplicate + flipped + t_junctions + missing_triangles + open_edges + non_manifold_edges +
+             joined_objects > 0;
     }
     std::string describe() const;  // "dropped 3 degenerate triangles; 12 open edges", or ""
   } repairs;

@@ -117,6 +117,19 @@ TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split the
   CHECK(door->repairs.open_edges == 0);
 }
 
+TEST_CASE("a hole of three edges is closed by the triangle missing there; a lone triangle is not", "[mesh][repairs]") {
+  const auto block = sim::load_mesh(data("planning/messy/meshes/missing_triangle_block_mm.obj"), 1e-3);
+  CHECK(block->repairs.missing_triangles == 1);
+  CHECK(block->repairs.open_edges == 0);
+  CHECK(block->repairs.flipped == 0);  // filled wound as its neighbours are
+  CHECK(block->convex);
+  CHECK(block->repairs.describe() == "1 missing triangle filled (a hole of three edges)");
+  // A hole of four edges (the open box's missing top) is left open.
+  const auto open_box = sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3);
+  CHECK(open_box->repairs.missing_triangles == 0);
+  CHECK(open_box->repairs.open_edges == 4);
+}
+
 TEST_CASE("T-junctions: a file of many open corners in one plane is read in bounded time, left open", "[mesh][repairs]") {
   // 20 000 loose triangles at x = 0: every open edge's corners share its x, so looking for
   // corners on each edge by x alone would be 60 000 squared checks.
@@ -133,6 +146,7 @@ TEST_CASE("T-junctions: a file of many open corners in one plane is read in boun
   std::filesystem::remove(file);
   CHECK(loose->repairs.open_edges == 60000);
   CHECK(loose->repairs.t_junctions == 0);
+  CHECK(loose->repairs.missing_triangles == 0);  // each hole's three edges are one triangle's own
 }
 
 TEST_CASE("an edge shared by more than two triangles is counted and said", "[mesh][repairs]") {
