@@ -117,7 +117,7 @@ TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split the
   CHECK(door->repairs.open_edges == 0);
 }
 
-TEST_CASE("a hole of three edges is closed by the triangle missing there; a lone triangle is not", "[mesh][repairs]") {
+TEST_CASE("a hole of three edges is closed by the triangle missing there, a hole of four is not", "[mesh][repairs]") {
   const auto block = sim::load_mesh(data("planning/messy/meshes/missing_triangle_block_mm.obj"), 1e-3);
   CHECK(block->repairs.missing_triangles == 1);
   CHECK(block->repairs.open_edges == 0);
