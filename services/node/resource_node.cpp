@@ -123,7 +123,8 @@ struct ResourceNode::Impl {
   template <class T, class P>
   void publish(const std::string& name, const std::string& topic, typename Pub<T, P>::ToSample to_sample) {
     // What a resource writes about itself goes in its partition (dds::owned_topic).
-    const dds::QosSettings settings = dds::owned_topic(topic) ? dds::owned_by({config.id}) : dds::QosSettings{};
+    const dds::QosSettings settings =
+        dds::own_events_qos(dds::owned_topic(topic) ? dds::owned_by({config.id}) : dds::QosSettings{});
     resource.add(std::make_unique<Pub<T, P>>(name, participant, topic, TopicKind::events, std::move(to_sample), settings));
   }
 
@@ -285,7 +286,7 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
       dds::command_qos());
   if (n.config.commanded_by_destination) commands.written_by([](const cell::Command& c) { return c.destination().to_string(); });
   n.overflow_answers = std::make_unique<dds::Outbox<cell::CommandEvent, cell::CommandEventPubSubType>>(
-      participant, "cell/command_events", TopicKind::events, dds::owned_by({n.config.id}));
+      participant, "cell/command_events", TopicKind::events, dds::own_events_qos(dds::owned_by({n.config.id})));
   commands.on_refused([&n](const cell::Command& c, const std::string& why) {
     cell::CommandEvent e;
     e.command_id(c.command_id());
