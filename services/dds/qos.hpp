@@ -35,7 +35,8 @@ inline QosSettings command_qos() {
   return s;
 }
 
-// A resource's writers of its own events (command events). Samples its readers have not yet
+// A resource's writers of its events (command events, proposals, award replies, its requests
+// to cell-sim: ResourceNode's publish blocks and its overflow answers). Samples its readers have not yet
 // acknowledged stay in the writer's history, whose buffers grow to the bound and never shrink;
 // a backlog past it waits in the writer's Outbox, whose memory is given back. At 4096 a flood
 // of 10 000 refused commands, read slowly on a loaded machine, left the station 22 MB of

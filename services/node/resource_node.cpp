@@ -309,10 +309,10 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.on_idle([&n] {
     n.overflow_answers->flush();
     if (n.overflowed != n.overflowed_published) n.publish_capability();
-    // Quiet after refused commands: what their events and samples took is given back to the
-    // system, so that a flood leaves no trace in resident memory. At every quiet moment after
-    // one, not every 1000: a flood that a loaded machine slows down has quiet moments in its
-    // middle, and what its tail took stayed (station +7 to +19 MB after 10 000, not +1.4).
+    // Quiet after refused commands: what their events and samples took on the heap is given
+    // back to the system, at every quiet moment after one (a flood that a loaded machine slows
+    // down has quiet moments in its middle). What DDS keeps in its writers' histories is not
+    // heap it frees: that is bounded by dds::own_events_qos.
     const std::size_t refused = n.device.refused() + n.overflowed;
     if (refused != n.refused_at_trim) {
       n.refused_at_trim = refused;
