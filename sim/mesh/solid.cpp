@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/boost/graph/helpers.h>
 
 namespace sim {
@@ -10,6 +11,43 @@ namespace {
 
 constexpr double kSampleSpacing = 2e-3;  // m, at most between surface samples
 constexpr int kMaxDivisions = 8;         // per triangle edge: large faces are sampled coarser
+constexpr double kMovedFrom = 4;         // resolutions: a piece this large outside is moved off
+constexpr double kOnSurface = 1e-9;      // m: a point this near the surface is on it
+
+using Exact = CGAL::Exact_predicates_inexact_constructions_kernel;  // exact predicates
+
+Exact::Point_3 exact_point(const SolidPoint& p) { return {p.x(), p.y(), p.z()}; }
+
+// Whether the triangle, moved by `shift`, meets no face of the surface (with exact predicates:
+// a face that only touches it meets it) and its middle is then outside. Then all of it is
+// outside once moved (it is one piece), so each of its points lies outside or within |shift|
+// of the surface: the way from the point to where it was moved crosses the surface.
+bool clear_when_moved(const Solid& solid, const std::array<Eigen::Vector3d, 3>& triangle, const Eigen::Vector3d& shift) {
+  std::array<Exact::Point_3, 3> moved;
+  CGAL::Bbox_3 box;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d p = triangle[i] + shift;
+    moved[i] = Exact::Point_3(p.x(), p.y(), p.z());
+    box += moved[i].bbox();
+  }
+  const Exact::Triangle_3 piece(moved[0], moved[1], moved[2]);
+  if (piece.is_degenerate()) return false;
+  // The faces near it: the box widened well past rounding, so that a face that meets the piece
+  // is among them though the box test is not exact.
+  constexpr double kWiden = 1e-7;  // m
+  box = CGAL::Bbox_3(box.xmin() - kWiden, box.ymin() - kWiden, box.zmin() - kWiden, box.xmax() + kWiden,
+                     box.ymax() + kWiden, box.zmax() + kWiden);
+  thread_local std::vector<Solid::Tree::Primitive_id> near;
+  near.clear();
+  solid.surface->all_intersected_primitives(box, std::back_inserter(near));
+  for (const auto f : near) {
+    const auto h = solid.mesh.halfedge(f);
+    const Exact::Triangle_3 face(exact_point(solid.mesh.point(solid.mesh.source(h))), exact_point(solid.mesh.point(solid.mesh.target(h))),
+                                 exact_point(solid.mesh.point(solid.mesh.target(solid.mesh.next(h)))));
+    if (face.is_degenerate() || CGAL::do_intersect(piece, face)) return false;
+  }
+  return !solid.contains(solid_point((triangle[0] + triangle[1] + triangle[2]) / 3 + shift));
+}
 
 }  // namespace
 
@@ -46,8 +84,13 @@ double Solid::depth(const Eigen::Vector3d& p, double tolerance) const {
   return distance > tolerance && contains(q, nearest, face) ? distance : 0;
 }
 
+const FlatRegions& Solid::flat_regions() const {
+  std::call_once(flat_once_, [&] { flat_ = std::make_unique<FlatRegions>(mesh); });
+  return *flat_;
+}
+
 std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eigen::Vector3d, 3>& triangle,
-                                        double tolerance, double resolution, bool deepest) {
+                                        double tolerance, double resolution, bool deepest, std::size_t* pieces_asked) {
   if (!solid.inside) return std::nullopt;
   std::optional<DeepPoint> found;
   std::vector<std::array<Eigen::Vector3d, 3>> pieces{triangle};
@@ -58,6 +101,7 @@ std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eig
     const double radius = std::max({(t[0] - middle).norm(), (t[1] - middle).norm(), (t[2] - middle).norm()});
     const SolidPoint q = solid_point(middle);
     const auto [nearest, face] = solid.surface->closest_point_and_primitive(q);
+    if (pieces_asked) ++*pieces_asked;
     const double distance = std::sqrt(CGAL::squared_distance(q, nearest));
     // Only a point deeper than this matters; the deepest is wanted to within the resolution.
     const double floor = deepest && found ? found->depth + resolution : tolerance;
@@ -70,10 +114,24 @@ std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eig
     double bound = 0;
     for (const auto& corner : t) bound = std::max(bound, CGAL::squared_distance(solid_point(corner), nearest_face));
     bound = std::sqrt(bound);
-    if (bound <= floor) continue;
+    if (bound <= floor || solid.flat_regions().within(face, t, floor)) continue;
     const bool in = solid.contains(q, nearest, face);
     if (std::min(bound, (in ? distance : -distance) + radius) <= floor) continue;
-    if (in && distance > floor) {
+    // A large piece outside but for where it touches or grazes the surface (a face standing on
+    // a face, a shaft's facet along a bore): moved three quarters of the floor outwards, is it
+    // clear?
+    // (Outwards: away from the middle's nearest surface point, or the face's normal where the
+    // middle lies on the face, as a facet on the bore's facet.)
+    if (radius > kMovedFrom * resolution && (!in || distance < floor / 2)) {
+      const auto n = CGAL::cross_product(nearest_face[1] - nearest_face[0], nearest_face[2] - nearest_face[0]);
+      const Eigen::Vector3d outwards =
+          distance > kOnSurface ? Eigen::Vector3d((middle - Eigen::Vector3d(nearest.x(), nearest.y(), nearest.z())) * ((in ? -1 : 1) / distance))
+                                : Eigen::Vector3d(Eigen::Vector3d(n.x(), n.y(), n.z()).normalized() * solid.orientation);
+      if (outwards.allFinite() && clear_when_moved(solid, t, outwards * (0.75 * floor))) continue;
+    }
+    // Kept when deeper than the deepest yet, though by less than the resolution: a point of
+    // this piece is then at most its radius deeper than the answer.
+    if (in && distance > (found ? found->depth : tolerance)) {
       found = DeepPoint{distance, middle};
       if (!deepest) return found;
     }

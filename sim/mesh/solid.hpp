@@ -7,7 +7,9 @@
 // the collision world's check of a concave part against a concave part.
 
 #include <array>
+#include <cstddef>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -18,6 +20,7 @@
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
 
+#include "sim/mesh/flat_regions.hpp"
 #include "sim/mesh/triangle_mesh.hpp"
 
 namespace sim {
@@ -45,6 +48,12 @@ struct Solid {
   // How deep a point lies inside: its distance from the surface, where that is more than
   // `tolerance` and it is inside; 0 otherwise.
   double depth(const Eigen::Vector3d& p, double tolerance) const;
+  // Its faces joined into flat regions; made when first asked (deepest_inside), once.
+  const FlatRegions& flat_regions() const;
+
+ private:
+  mutable std::once_flag flat_once_;
+  mutable std::unique_ptr<FlatRegions> flat_;
 };
 
 // A point of a triangle that lies inside a solid, and how deep.
@@ -58,13 +67,16 @@ struct DeepPoint {
 // where no point of it can lie deeper than `tolerance` (its corners' distance from the face
 // nearest its middle bounds every inner point's depth: the distance to a face is convex) or
 // where it lies wholly outside (its middle outside, farther from the surface than any of its
-// points is from the middle).
+// points is from the middle), or where it lies over one flat region of the surface, its
+// corners within `tolerance` of the region's plane (FlatRegions: a sliver lying on a panel's face).
 // Returns a point deeper than `tolerance` (with `deepest`, the deepest to within
 // `resolution`; else the first), or nothing. Down to pieces of circumradius `resolution`: a point up to that much
 // deeper than `tolerance` in a piece of that size may go unseen (never one deeper than
-// tolerance + resolution). A solid without an inside holds nothing.
+// tolerance + resolution). A solid without an inside holds nothing. `pieces_asked` counts the
+// pieces whose nearest surface point was asked for (each a query of the surface's tree).
 std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eigen::Vector3d, 3>& triangle,
-                                        double tolerance, double resolution, bool deepest = false);
+                                        double tolerance, double resolution, bool deepest = false,
+                                        std::size_t* pieces_asked = nullptr);
 
 inline SolidPoint solid_point(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
