@@ -5,6 +5,7 @@
 #include "twin/planning/subassembly_planner.hpp"
 
 #include <algorithm>
+#include <bitset>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -55,6 +56,7 @@ class Search {
       scene_.assemble(step.part);
       plan_.steps.push_back(step);
     }
+    most_placeable_ = assembled_.size() - fewest_left_out();
     plan_.complete = extend();
     if (best_) keep_best_order();
     if (!plan_.complete && deepest_.size() > plan_.steps.size()) plan_.steps = deepest_;
@@ -70,6 +72,10 @@ class Search {
   // Depth-first: returns true once every part is in.
   bool extend() {
     if (plan_.steps.size() == assembled_.size()) return order_found();
+    if (plan_.steps.size() >= most_placeable_) {  // no plan holds more: the search is done
+      stopped_ = at_most_placeable_ = true;
+      return false;
+    }
     if (failed_states_.count(assembled_)) return false;
     const std::vector<PartIndex> allowed(scene_.frontier().begin(), scene_.frontier().end());
     for (PartIndex part : sequence_.candidates(scene_)) {
@@ -295,6 +301,53 @@ class Search {
     return false;
   }
 
+  // The fewest parts any plan leaves out because they overlap others in the finished product:
+  // of each overlapping pair one stays out, so as many as the least set of parts that holds
+  // one of every pair (a vertex cover; the given parts are in). Exact over up to 20 parts
+  // that overlap; over more, the pairs of a greedy matching, each of which leaves one out.
+  std::size_t fewest_left_out() const {
+    std::vector<PartIndex> involved;
+    std::vector<std::pair<PartIndex, PartIndex>> pairs;
+    std::size_t forced = 0;  // the partner of a given part stays out
+    std::set<PartIndex> out;
+    for (const Interference& i : interferences_) {
+      const bool given1 = assembled_[i.part1], given2 = assembled_[i.part2];
+      if (given1 && given2) continue;
+      if (given1 || given2) {
+        if (out.insert(given1 ? i.part2 : i.part1).second) ++forced;
+        continue;
+      }
+      pairs.emplace_back(i.part1, i.part2);
+    }
+    pairs.erase(std::remove_if(pairs.begin(), pairs.end(), [&](const auto& e) { return out.count(e.first) || out.count(e.second); }),
+                pairs.end());
+    for (const auto& [a, b] : pairs) {
+      for (PartIndex p : {a, b}) {
+        if (std::find(involved.begin(), involved.end(), p) == involved.end()) involved.push_back(p);
+      }
+    }
+    if (involved.size() > 20) {
+      std::set<PartIndex> matched;
+      std::size_t matching = 0;
+      for (const auto& [a, b] : pairs) {
+        if (matched.count(a) || matched.count(b)) continue;
+        matched.insert({a, b});
+        ++matching;
+      }
+      return forced + matching;
+    }
+    const auto bit = [&](PartIndex p) { return 1u << (std::find(involved.begin(), involved.end(), p) - involved.begin()); };
+    std::size_t fewest = involved.size();
+    for (std::uint32_t cover = 0; cover < (1u << involved.size()); ++cover) {
+      const std::size_t size = std::bitset<32>(cover).count();
+      if (size >= fewest) continue;
+      if (std::all_of(pairs.begin(), pairs.end(), [&](const auto& e) { return (cover & bit(e.first)) || (cover & bit(e.second)); })) {
+        fewest = size;
+      }
+    }
+    return forced + fewest;
+  }
+
   std::optional<PartIndex> overlapping_assembled(PartIndex part) const {
     for (const Interference& i : interferences_) {
       if (i.part1 == part && assembled_[i.part2]) return i.part2;
@@ -307,6 +360,15 @@ class Search {
   std::string why_not(PartIndex p) {
     if (const auto fell = falls_.find(p); fell != falls_.end() && !unplaceable_.count(p)) {
       return "it would not stand where it goes: " + describe(product_.product, fell->second, options_.stand);
+    }
+    if (at_most_placeable_) {
+      if (const auto other = overlapping_assembled(p)) {
+        for (const Interference& i : interferences_) {
+          if ((i.part1 == p && i.part2 == *other) || (i.part2 == p && i.part1 == *other)) {
+            return describe(product_.product, i) + " (of the two, one stays out)";
+          }
+        }
+      }
     }
     if (unplaceable_.count(p)) {
       const auto& blockers = blocked_by_[p];
@@ -397,6 +459,13 @@ class Search {
                                 names});
     }
     report_open_order();
+    if (at_most_placeable_) {
+      plan_.findings.push_back({"search-bound",
+                                "the search stopped at " + std::to_string(plan_.steps.size()) + " of " +
+                                    std::to_string(assembled_.size()) + " parts, the most any plan holds: of each pair "
+                                    "of parts that overlap in the finished product one stays out",
+                                {}});
+    }
     if (timed_out_ && !plan_.complete) {
       plan_.findings.push_back({"gave-up",
                                 "the search reached its time limit of " + std::to_string(static_cast<int>(options_.time_limit)) +
@@ -470,6 +539,8 @@ class Search {
   std::size_t orders_found_ = 0, first_backtracks_ = 0;
   std::set<PartIndex> first_backtracked_;
   bool stopped_ = false;
+  std::size_t most_placeable_ = 0;  // no plan holds more parts (fewest_left_out)
+  bool at_most_placeable_ = false;  // the search stopped there
   std::optional<std::pair<PartIndex, std::size_t>> stopped_at_;  // the part and step a sequence ended at
   const StabilityAnalysis* stability_;
   std::map<std::vector<bool>, Standing> standing_;  // by the parts in place, the new one among them
