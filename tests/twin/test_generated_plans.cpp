@@ -8,23 +8,14 @@
 #include <catch2/catch.hpp>
 
 #include "tests/support/generated_products.hpp"
+#include "tests/support/sanitizers.hpp"
 #include "twin/planning/assembly_planner.hpp"
 #include "twin/planning/path_planner.hpp"
 
 namespace {
 
-// Fewer under the sanitizers, which run the geometry 20 to 30 times slower.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr std::uint32_t kScale = 40;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(undefined_behavior_sanitizer)
-constexpr std::uint32_t kScale = 40;
-#else
-constexpr std::uint32_t kScale = 1;
-#endif
-#else
-constexpr std::uint32_t kScale = 1;
-#endif
+// Fewer under the sanitizers.
+constexpr std::uint32_t kScale = test::kUnderSanitizers ? 40 : 1;
 
 struct Tally {
   std::size_t complete = 0, refused = 0;

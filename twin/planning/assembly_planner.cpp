@@ -105,7 +105,7 @@ class Search {
       } else {
         while ((trajectory = path_.next(scene_, part, tried))) {
           ++plan_.trajectories_simulated;
-          auto collision = scene_.simulate_grasps(part, *trajectory);
+          auto collision = scene_.simulate_grasps(part, *trajectory, path_.trajectories_nest() ? &known_ : nullptr);
           if (!collision) break;
           if (!collision->with.empty()) {
             (collision->member == "part" ? blocked_by_ : gripper_blocked_by_)[part].insert(collision->with);
@@ -546,6 +546,7 @@ class Search {
   std::map<std::vector<bool>, Standing> standing_;  // by the parts in place, the new one among them
   std::map<PartIndex, std::vector<std::vector<bool>>> blocked_among_;  // parts in place where a part found no way
   std::map<PartIndex, std::vector<Way>> ways_;                       // and where it found one
+  KnownCollisions known_;                                            // grasps' collisions that recur
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   bool timed_out_ = false;
   std::map<PartIndex, Instability> falls_;          // the last group each part would have made fall

@@ -161,7 +161,27 @@ std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajector
   return std::nullopt;
 }
 
-std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajectory& trajectory) const {
+std::optional<Collision> KnownCollisions::recurring(const AssemblyScene& scene, PartIndex part, const std::string& trajectory,
+                                                    const std::string& grasp) const {
+  const auto it = known_.find({part, trajectory, grasp});
+  if (it == known_.end()) return std::nullopt;
+  for (const Collision& c : it->second) {
+    const auto other = scene.product().product.find_part_by_name(c.with);
+    if (c.with == "station" || (other && scene.is_assembled(*other))) {
+      ++answered_;
+      return c;
+    }
+  }
+  return std::nullopt;
+}
+
+void KnownCollisions::remember(PartIndex part, const std::string& trajectory, const std::string& grasp,
+                               const Collision& collision) {
+  if (collision.phase != "insert" && collision.phase != "release" && collision.phase != "retreat") return;
+  known_[{part, trajectory, grasp}].push_back(collision);
+}
+
+std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajectory& trajectory, KnownCollisions* known) const {
   const std::vector<Grasp> all = grasps(part, trajectory.direction);
   if (all.empty()) {
     // Narrower than the gripper opens on no pair of faces: by how much, at the narrowest.
@@ -174,12 +194,19 @@ std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajecto
     if (g.label != trajectory.grasp.label && holds(part, g)) holding.push_back(g);
   }
   if (holding.empty()) return Collision{"", "finger", 0, "gripping"};
-  trajectory.hold_by(holding.front());
-  std::optional<Collision> first = simulate(part, trajectory);
+  const auto run = [&](const Grasp& grasp) {
+    trajectory.hold_by(grasp);
+    if (known) {
+      if (auto c = known->recurring(*this, part, trajectory.label, grasp.label)) return c;
+    }
+    auto c = simulate(part, trajectory);
+    if (known && c) known->remember(part, trajectory.label, grasp.label, *c);
+    return c;
+  };
+  std::optional<Collision> first = run(holding.front());
   if (!first || first->member == "part") return first;  // no other grasp helps a part that hits
   for (std::size_t i = 1; i < holding.size(); ++i) {
-    trajectory.hold_by(holding[i]);
-    if (!simulate(part, trajectory)) return std::nullopt;
+    if (!run(holding[i])) return std::nullopt;
   }
   trajectory.hold_by(holding.front());
   return first;

@@ -38,6 +38,24 @@ struct HeldPart {
   sim::MovingBody arm;       // the gripper, in its own frame
 };
 
+class AssemblyScene;
+
+// Collisions that recur: where a grasp's part or gripper hit the station, or a part in place,
+// while inserting, releasing or backing out, it hits it again whenever that part is in place,
+// for a path planner whose trajectories nest (PathPlanner::trajectories_nest). The search keeps
+// them by part, trajectory and grasp, and runs a grasp only where none recurs.
+class KnownCollisions {
+ public:
+  std::optional<Collision> recurring(const AssemblyScene& scene, PartIndex part, const std::string& trajectory,
+                                     const std::string& grasp) const;
+  void remember(PartIndex part, const std::string& trajectory, const std::string& grasp, const Collision& collision);
+  std::size_t answered() const { return answered_; }
+
+ private:
+  std::map<std::tuple<PartIndex, std::string, std::string>, std::vector<Collision>> known_;
+  mutable std::size_t answered_ = 0;
+};
+
 class AssemblyScene {
  public:
   AssemblyScene(const LoadedProduct& product, sim::CollisionOptions options = {}, fb::GripperGeometry gripper = {});
@@ -84,8 +102,9 @@ class AssemblyScene {
   // Runs the trajectory with its own grasp, then with the part's other grasps for its
   // direction, and keeps the first that is free of collisions through insertion and
   // retreat. Where none is, the trajectory keeps its own grasp and the answer is its
-  // collision (or, with no grasp at all, one of phase "grasp").
-  std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory) const;
+  // collision (or, with no grasp at all, one of phase "grasp"). With `known`, a grasp whose
+  // collision recurs is not run again, and what is found is remembered there.
+  std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory, KnownCollisions* known = nullptr) const;
 
   // The least room the part, and the gripper holding it, have on the trajectory's way in
   // (every stretch it is held), within `reach`: nothing when there is more. This is the room

@@ -24,6 +24,9 @@ class PathPlanner {
   // same assembled parts; nothing when the planner has no more.
   virtual std::optional<Trajectory> next(const AssemblyScene& scene, PartIndex part,
                                          const std::vector<Attempt>& tried) = 0;
+  // Whether a trajectory with more parts in place holds the insertion, release and retreat of
+  // the same one with fewer (the search then takes a collision there as known: KnownCollisions).
+  virtual bool trajectories_nest() const { return false; }
 };
 
 // Straight insertion along candidate directions: down, up from below, +x, -x, +z, -z. The
@@ -35,6 +38,8 @@ class LinearPathPlanner : public PathPlanner {
   std::string name() const override { return "linear"; }
   std::optional<Trajectory> next(const AssemblyScene& scene, PartIndex part,
                                  const std::vector<Attempt>& tried) override;
+  // It starts farther back, and backs out farther, as the assembly grows, on the same lines.
+  bool trajectories_nest() const override { return true; }
 
   static const std::vector<std::pair<std::string, Vec3>>& directions();
   static Trajectory straight_insertion(const AssemblyScene& scene, PartIndex part, const std::string& label,
