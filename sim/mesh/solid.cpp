@@ -118,10 +118,9 @@ std::optional<DeepPoint> deepest_inside(const Solid& solid, const std::array<Eig
     const bool in = solid.contains(q, nearest, face);
     if (std::min(bound, (in ? distance : -distance) + radius) <= floor) continue;
     // A large piece outside but for where it touches or grazes the surface (a face standing on
-    // a face, a shaft's facet along a bore): moved three quarters of the floor outwards, is it
-    // clear?
-    // (Outwards: away from the middle's nearest surface point, or the face's normal where the
-    // middle lies on the face, as a facet on the bore's facet.)
+    // a face, a shaft's facet along a bore): is it clear, moved three quarters of the floor
+    // outwards (away from the middle's nearest surface point; along the face's normal where
+    // the middle lies on the face, as a facet on a bore's facet)?
     if (radius > kMovedFrom * resolution && (!in || distance < floor / 2)) {
       const auto n = CGAL::cross_product(nearest_face[1] - nearest_face[0], nearest_face[2] - nearest_face[0]);
       const Eigen::Vector3d outwards =
