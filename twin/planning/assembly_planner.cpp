@@ -82,8 +82,8 @@ class Search {
       if (plan_.steps.size() == options_.given.size() && options_.not_next.count(part)) continue;
       tried_.insert(part);
       // A part that overlaps one in place in the finished product goes in on no path.
-      if (const auto other = overlapping_assembled(part)) {
-        blocked_by_[part].insert(name(*other));
+      if (const Interference* overlap = overlap_in_place(part)) {
+        blocked_by_[part].insert(name(overlap->part1 == part ? overlap->part2 : overlap->part1));
         unplaceable_.insert(part);
         if (!sequence_.backtracks()) return give_up(part);
         continue;
@@ -308,13 +308,12 @@ class Search {
   std::size_t fewest_left_out() const {
     std::vector<PartIndex> involved;
     std::vector<std::pair<PartIndex, PartIndex>> pairs;
-    std::size_t forced = 0;  // the partner of a given part stays out
-    std::set<PartIndex> out;
+    std::set<PartIndex> out;  // the partners of given parts stay out
     for (const Interference& i : interferences_) {
       const bool given1 = assembled_[i.part1], given2 = assembled_[i.part2];
       if (given1 && given2) continue;
       if (given1 || given2) {
-        if (out.insert(given1 ? i.part2 : i.part1).second) ++forced;
+        out.insert(given1 ? i.part2 : i.part1);
         continue;
       }
       pairs.emplace_back(i.part1, i.part2);
@@ -334,26 +333,26 @@ class Search {
         matched.insert({a, b});
         ++matching;
       }
-      return forced + matching;
+      return out.size() + matching;
     }
     const auto bit = [&](PartIndex p) { return 1u << (std::find(involved.begin(), involved.end(), p) - involved.begin()); };
+    std::vector<std::uint32_t> pair_bits;
+    for (const auto& e : pairs) pair_bits.push_back(bit(e.first) | bit(e.second));
     std::size_t fewest = involved.size();
     for (std::uint32_t cover = 0; cover < (1u << involved.size()); ++cover) {
       const std::size_t size = std::bitset<32>(cover).count();
       if (size >= fewest) continue;
-      if (std::all_of(pairs.begin(), pairs.end(), [&](const auto& e) { return (cover & bit(e.first)) || (cover & bit(e.second)); })) {
-        fewest = size;
-      }
+      if (std::all_of(pair_bits.begin(), pair_bits.end(), [&](std::uint32_t pair) { return (cover & pair) != 0; })) fewest = size;
     }
-    return forced + fewest;
+    return out.size() + fewest;
   }
 
-  std::optional<PartIndex> overlapping_assembled(PartIndex part) const {
+  // The overlap in the finished product between the part and one in place, if any.
+  const Interference* overlap_in_place(PartIndex part) const {
     for (const Interference& i : interferences_) {
-      if (i.part1 == part && assembled_[i.part2]) return i.part2;
-      if (i.part2 == part && assembled_[i.part1]) return i.part1;
+      if ((i.part1 == part && assembled_[i.part2]) || (i.part2 == part && assembled_[i.part1])) return &i;
     }
-    return std::nullopt;
+    return nullptr;
   }
 
   // Why a part is not in the plan, as far as the search knows.
@@ -362,12 +361,8 @@ class Search {
       return "it would not stand where it goes: " + describe(product_.product, fell->second, options_.stand);
     }
     if (at_most_placeable_) {
-      if (const auto other = overlapping_assembled(p)) {
-        for (const Interference& i : interferences_) {
-          if ((i.part1 == p && i.part2 == *other) || (i.part2 == p && i.part1 == *other)) {
-            return describe(product_.product, i) + " (of the two, one stays out)";
-          }
-        }
+      if (const Interference* overlap = overlap_in_place(p)) {
+        return describe(product_.product, *overlap) + " (of the two, one stays out)";
       }
     }
     if (unplaceable_.count(p)) {
