@@ -89,11 +89,14 @@ struct DeepestContact : btCollisionWorld::ContactResultCallback {
   std::vector<Crossing> crossings;
   int child = -1;  // >= 0: `self` stands for this one child of the moving compound
   bool skip_hulls = false;  // leave out concave bodies' hulls
+  BodyId ignore = -1;       // a body left out (CollisionWorld::penetration)
 
-  DeepestContact(const btCollisionObject* s, double t) : self(s), tolerance(t) {}
+  DeepestContact(const btCollisionObject* s, double t, BodyId leave_out = -1) : self(s), tolerance(t), ignore(leave_out) {}
 
   bool needsCollision(btBroadphaseProxy* proxy) const override {
-    if (skip_hulls && static_cast<const btCollisionObject*>(proxy->m_clientObject)->getUserIndex2() == kCoarse) return false;
+    const auto* object = static_cast<const btCollisionObject*>(proxy->m_clientObject);
+    if (ignore >= 0 && object->getUserIndex() == ignore) return false;
+    if (skip_hulls && object->getUserIndex2() == kCoarse) return false;
     return ContactResultCallback::needsCollision(proxy);
   }
 
@@ -667,7 +670,7 @@ void CollisionWorld::remove(BodyId body) {
   impl_->bodies.erase(it);
 }
 
-std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const Pose& pose) const {
+std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const Pose& pose, BodyId ignore) const {
   ++checks_;
   MovingBody::Impl& moving = *body.impl_;
   const double tolerance = options_.contact_tolerance;
@@ -684,7 +687,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   // body is asked against their triangles right away (the coarse hull's GJK against each of
   // the thousands of triangles near it was half the time of a ring set into a ring).
   moving.coarse.object.setWorldTransform(at);
-  DeepestContact coarse(&moving.coarse.object, tolerance);
+  DeepestContact coarse(&moving.coarse.object, tolerance, ignore);
   if (!moving.has_exact) {
     impl_->contact_test(moving.coarse.object, coarse);
     return contact_of(coarse, moving.coarse);
@@ -767,7 +770,7 @@ std::optional<Contact> CollisionWorld::penetration(const MovingBody& body, const
   // touching pair of triangles, and only then the volumes.
   MovingBody::Impl::Shape& exact = moving.exact_shape();
   exact.object.setWorldTransform(at);
-  DeepestContact callback(&exact.object, tolerance);
+  DeepestContact callback(&exact.object, tolerance, ignore);
   callback.skip_hulls = true;
   impl_->world.contactTest(&exact.object, callback);
   btCollisionObject probe;
@@ -938,14 +941,14 @@ bool CollisionWorld::clear_translation(const MovingBody& body, const Pose& from,
 // overlaps no body is free as a whole, and so is a stretch without turning whose swept volume
 // is clear; the rest is halved down to linear_step and sampled. Samples go in order along
 // the sweep, so the first collision is the one reported.
-std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose& from, const Pose& to) const {
+std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose& from, const Pose& to, BodyId ignore) const {
   const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
   const double travel = (to.translation() - from.translation()).norm() + angle * body.radius();
   const btCollisionShape& shape = body.impl_->coarse.compound;
   const double pad = (angle * body.radius() + options_.shape_margin) * kUnitsPerMetre;
   // Only for convex members: the hull of a concave one-piece member reaches into what it
   // mates with (a brick's hull into the studs below), and its swept volume would only fail.
-  const bool translating = angle < 1e-9 && !body.impl_->has_exact;
+  const bool translating = angle < 1e-9 && !body.impl_->has_exact && ignore < 0;
 
   std::optional<Contact> hit;
   auto visit = [&](auto&& self, double s0, double s1, bool check_start) -> bool {
@@ -966,7 +969,7 @@ std::optional<Contact> CollisionWorld::sweep(const MovingBody& body, const Pose&
     if ((s1 - s0) * travel <= options_.linear_step) {
       for (auto [s, pose] : {std::pair{s0, a}, std::pair{s1, b}}) {
         if (s == s0 && !check_start) continue;
-        if (auto contact = penetration(body, pose)) {
+        if (auto contact = penetration(body, pose, ignore)) {
           contact->fraction = s;
           hit = contact;
           return true;

@@ -101,10 +101,11 @@ class CollisionWorld {
   // A penetration of the body at a pose deeper than the tolerance, if there is one: the deepest
   // where pieces meet as convex shapes; where a concave member goes into a concave body, the
   // first point found past the tolerance, whose depth is then a least one.
-  std::optional<Contact> penetration(const MovingBody& body, const Pose& pose) const;
+  // `ignore`: a body the moving one may go into (a nut on the bolt it turns onto).
+  std::optional<Contact> penetration(const MovingBody& body, const Pose& pose, BodyId ignore = -1) const;
   // The first collision while moving from one pose to another, translating and turning
   // together (slerp), sampled so that no point moves more than linear_step between samples.
-  std::optional<Contact> sweep(const MovingBody& body, const Pose& from, const Pose& to) const;
+  std::optional<Contact> sweep(const MovingBody& body, const Pose& from, const Pose& to, BodyId ignore = -1) const;
   // The nearest static body within `reach` of the moving body at the pose, of the pairs that
   // `counts` (when given) keeps; nothing when none is that near.
   std::optional<Clearance> nearest(const MovingBody& body, const Pose& pose, double reach,

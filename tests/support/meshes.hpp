@@ -73,6 +73,48 @@ inline sim::TriangleMesh tube_mesh(int segments, double outer, double inner, dou
   return m;
 }
 
+// A tube along y from `y0` to `y1` of one piece whose outer and inner radii (m) are functions
+// of the angle round y (t = atan2(z, x)) and the height: a thread is r = f(y + pitch t / 2 pi).
+// `segments` around, `levels` up; an inner radius of 0 makes a solid rod. Faces outwards.
+template <class Outer, class Inner>
+sim::TriangleMesh revolved_tube(int segments, int levels, double y0, double y1, Outer outer, Inner inner) {
+  sim::TriangleMesh m;
+  m.pieces.emplace_back();
+  for (int level = 0; level <= levels; ++level) {
+    const double y = y0 + (y1 - y0) * level / levels;
+    for (int k = 0; k < segments; ++k) {
+      const double t = 2 * M_PI * k / segments;
+      const double ro = outer(t, y), ri = inner(t, y);
+      m.vertices.emplace_back(ro * std::cos(t), y, ro * std::sin(t));
+      m.vertices.emplace_back(ri * std::cos(t), y, ri * std::sin(t));
+    }
+  }
+  const auto o = [&](int level, int k) { return static_cast<std::uint32_t>(level * 2 * segments + 2 * (k % segments)); };
+  const bool solid = inner(0.0, y0) <= 0;
+  for (int level = 0; level < levels; ++level) {
+    for (int k = 0; k < segments; ++k) {
+      const auto a = o(level, k), b = o(level, k + 1), c = o(level + 1, k + 1), d = o(level + 1, k);
+      m.triangles.insert(m.triangles.end(), {{a, c, b}, {a, d, c}});  // outside
+      if (!solid) m.triangles.insert(m.triangles.end(), {{a + 1, b + 1, c + 1}, {a + 1, c + 1, d + 1}});  // bore
+    }
+  }
+  for (int k = 0; k < segments; ++k) {
+    const auto a = o(0, k), b = o(0, k + 1), c = o(levels, k + 1), d = o(levels, k);
+    if (solid) {  // a fan round one middle vertex at each end: closed
+      m.triangles.push_back({d, o(levels, 0) + 1, c});
+      m.triangles.push_back({a, b, o(0, 0) + 1});
+      continue;
+    }
+    m.triangles.insert(m.triangles.end(), {{d, c + 1, c}, {d, d + 1, c + 1}});  // top
+    m.triangles.insert(m.triangles.end(), {{a, b, b + 1}, {a, b + 1, a + 1}});  // bottom
+  }
+  for (std::uint32_t i = 0; i < m.vertices.size(); ++i) {
+    m.pieces.back().push_back(i);
+    m.bounds.extend(m.vertices[i]);
+  }
+  return m;
+}
+
 // A U channel of one piece along x, as a CAD export writes it: its long faces two triangles
 // each from end to end, so no corner and no middle of them lies near the channel's own
 // middle. Open upwards: a base `thickness` thick, walls `thickness` thick and `height` tall,

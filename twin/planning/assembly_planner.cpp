@@ -2,7 +2,9 @@
 
 #include "twin/planning/interference.hpp"
 #include "twin/planning/plan_verifier.hpp"
+#include "twin/planning/screw_path.hpp"
 #include "twin/planning/subassembly_planner.hpp"
+#include "twin/planning/threads.hpp"
 
 #include <algorithm>
 #include <bitset>
@@ -47,7 +49,13 @@ class Search {
     plan_.margin_reach = options_.margin_reach;
     report_meshes();
     // Overlaps in the finished product first: no path can resolve them.
-    for (const Interference& i : find_interferences(product_, options_.collision).overlaps) {
+    for (Interference& i : find_interferences(product_, options_.collision).overlaps) {
+      if (auto thread = thread_of(product_, i)) {
+        plan_.findings.push_back({"thread", describe(product_.product, *thread), {name(thread->part2), name(thread->part1)}});
+        threads_.push_back(*thread);
+        scene_.link(thread->part1, thread->part2);
+        continue;
+      }
       plan_.findings.push_back({"interference", describe(product_.product, i), {name(i.part2), name(i.part1)}});
       interferences_.push_back(i);
     }
@@ -103,7 +111,19 @@ class Search {
         trajectory = way->trajectory;
         tried = way->tried;
       } else {
-        while ((trajectory = path_.next(scene_, part, tried))) {
+        // A part whose thread's mate is in place goes in on the helix only; into two threads at
+        // once it cannot turn.
+        const std::vector<const Thread*> threads = threads_in_place(part);
+        if (threads.size() > 1) two_threads_.insert(part);
+        std::vector<Trajectory> screws = threads.size() == 1 ? screw_insertions(scene_, part, *threads.front())
+                                                             : std::vector<Trajectory>{};
+        std::size_t next_screw = 0;
+        const auto next = [&]() -> std::optional<Trajectory> {
+          if (threads.empty()) return path_.next(scene_, part, tried);
+          if (next_screw < screws.size()) return std::move(screws[next_screw++]);
+          return std::nullopt;
+        };
+        while ((trajectory = next())) {
           ++plan_.trajectories_simulated;
           auto collision = scene_.simulate_grasps(part, *trajectory, path_.trajectories_nest() ? &known_ : nullptr);
           if (!collision) break;
@@ -355,6 +375,24 @@ class Search {
     return nullptr;
   }
 
+  // "leg1, leg2": the parts the part is threaded to.
+  std::string threads_named(PartIndex part) const {
+    std::vector<std::string> names;
+    for (const Thread& t : threads_) {
+      if (t.part1 == part || t.part2 == part) names.push_back(name(t.other(part)));
+    }
+    return join(names);
+  }
+
+  // The threads whose mates are in place: the part turns into them.
+  std::vector<const Thread*> threads_in_place(PartIndex part) const {
+    std::vector<const Thread*> out;
+    for (const Thread& t : threads_) {
+      if ((t.part1 == part || t.part2 == part) && assembled_[t.other(part)]) out.push_back(&t);
+    }
+    return out;
+  }
+
   // Why a part is not in the plan, as far as the search knows.
   std::string why_not(PartIndex p) {
     if (const auto fell = falls_.find(p); fell != falls_.end() && !unplaceable_.count(p)) {
@@ -383,6 +421,9 @@ class Search {
         if (!gripper.empty()) what += "the gripper hit " + join({gripper.begin(), gripper.end()}) + " on every grasp";
         why.push_back(what + " (deepest: the " + c.member + " hit " + c.with + " " + millimetres(c.depth) +
                       " deep while " + c.phase + ")");
+      }
+      if (two_threads_.count(p)) {
+        why.push_back("where it would turn into two threads at once (" + threads_named(p) + "), it cannot");
       }
       if (const std::size_t n = scene_.grasps_in_members(p); n > 0) {
         why.push_back(std::to_string(n) + (n == 1 ? " grasp" : " grasps") + " of its base would put the gripper in its " +
@@ -528,6 +569,8 @@ class Search {
   std::set<PartIndex> tried_;
   std::map<PartIndex, Collision> worst_;  // the deepest collision of each part's tries
   std::vector<Interference> interferences_;
+  std::vector<Thread> threads_;  // overlaps that are threads: the part goes in on a helix
+  std::set<PartIndex> two_threads_;  // parts that met the mates of two of their threads in place
   // Objective::margin: the best order so far, and what the first one found was.
   std::optional<std::vector<PlanStep>> best_;
   double best_margin_ = 0, first_margin_ = 0;
@@ -559,6 +602,11 @@ std::string step_name(const Product& product, const PlanStep& step) {
 
 std::string step_result(const PlanStep& step) {
   std::string out = step.failed.empty() ? "ok" : "ok after " + std::to_string(step.failed.size()) + " collision(s)";
+  if (const auto& screw = step.trajectory.screw) {
+    char turns[48];
+    std::snprintf(turns, sizeof turns, ", screwed %.1f turns", screw->turns);
+    out += turns;
+  }
   if (step.hold) out += ", held until fastened";
   if (!step.fixture.empty()) out += ", a fixture holds " + std::to_string(step.fixture.size()) + " part(s) from here";
   return out;

@@ -68,8 +68,17 @@ void AssemblyScene::disassemble(PartIndex part) {
   for (PartIndex next : product_.product.successors(part)) update_frontier(next);
 }
 
+void AssemblyScene::link(PartIndex a, PartIndex b) {
+  links_.emplace_back(a, b);
+  update_frontier(a);
+  update_frontier(b);
+}
+
 std::vector<PartIndex> AssemblyScene::neighbours(PartIndex part) const {
   std::vector<PartIndex> out;
+  for (const auto& [a, b] : links_) {
+    if (a == part || b == part) out.push_back(a == part ? b : a);
+  }
   const Product& product = product_.product;
   for (std::size_t ci : product.connections_of(part)) {
     const Connection& c = product.connections()[ci];
@@ -153,12 +162,28 @@ std::optional<Collision> AssemblyScene::simulate(PartIndex part, const Trajector
   if (w.front().holding) {
     if (auto c = collision_at(held.with_arm, w.front().part, w.front().phase)) return c;
   }
+  // Turning into its thread, the part goes into the mate by the thread's overlap: the part and
+  // gripper are checked against all else, the gripper alone against the mate too.
+  const sim::BodyId mate = thread_mate(trajectory);
   for (std::size_t i = 1; i < w.size(); ++i) {
-    const auto contact = w[i].holding ? world_.sweep(held.with_arm, w[i - 1].part, w[i].part)
-                                      : world_.sweep(held.arm, w[i - 1].gripper, w[i].gripper);
+    std::optional<sim::Contact> contact;
+    if (!w[i].holding) {
+      contact = world_.sweep(held.arm, w[i - 1].gripper, w[i].gripper);
+    } else if (w[i].phase == "screw" && mate >= 0) {
+      contact = world_.sweep(held.with_arm, w[i - 1].part, w[i].part, mate);
+      if (!contact) contact = world_.sweep(held.arm, w[i - 1].gripper, w[i].gripper);
+    } else {
+      contact = world_.sweep(held.with_arm, w[i - 1].part, w[i].part);
+    }
     if (contact) return to_collision(*contact, w[i].phase);
   }
   return std::nullopt;
+}
+
+sim::BodyId AssemblyScene::thread_mate(const Trajectory& trajectory) const {
+  if (!trajectory.screw) return -1;
+  const auto it = bodies_.find(trajectory.screw->mate);
+  return it == bodies_.end() ? -1 : it->second;
 }
 
 std::optional<Collision> KnownCollisions::recurring(const AssemblyScene& scene, PartIndex part, const std::string& trajectory,
@@ -224,7 +249,8 @@ std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& tr
   for (std::size_t i = 1; i < w.size(); ++i) last = w[i].holding ? i : last;
   std::optional<Margin> least;
   for (std::size_t i = 1; i < w.size(); ++i) {
-    if (!w[i].holding) continue;
+    // Turning in its thread, the part has the thread's room (its collisions are checked).
+    if (!w[i].holding || w[i].phase == "screw") continue;
     Pose to = w[i].part;
     if (i == last) {
       // Seated, the part touches what it sits on, and where faces touch flat Bullet's normal

@@ -63,6 +63,8 @@ class AssemblyScene {
   const LoadedProduct& product() const { return product_; }
   const fb::GripperGeometry& gripper() const { return gripper_; }
 
+  // Joins two parts as a link does (a thread the geometry shows: threads.hpp).
+  void link(PartIndex a, PartIndex b);
   void assemble(PartIndex part);
   void disassemble(PartIndex part);
   bool is_assembled(PartIndex part) const { return bodies_.count(part) > 0; }
@@ -119,6 +121,9 @@ class AssemblyScene {
 
  private:
   Collision to_collision(const sim::Contact& contact, const std::string& phase) const;
+  // The body of the part a trajectory turns its part into (Trajectory::screw), where it stands;
+  // else -1.
+  sim::BodyId thread_mate(const Trajectory& trajectory) const;
 
   const LoadedProduct& product_;
   fb::GripperGeometry gripper_;
@@ -134,6 +139,7 @@ class AssemblyScene {
   std::vector<Eigen::AlignedBox3d> grasp_bounds_;  // of what the gripper holds each part by
   Eigen::AlignedBox3d assembled_bounds_;
   std::set<PartIndex> frontier_;
+  std::vector<std::pair<PartIndex, PartIndex>> links_;  // besides the product's (link())
   std::map<PartIndex, sim::BodyId> bodies_;
   std::map<sim::BodyId, std::string> names_;
   // holds(), by part and grasp label (a label names one grasp of a part's box).

@@ -18,9 +18,10 @@ using Point = sim::SolidPoint;
 // How deep a's surface reaches into b, each at its pose: the largest distance from b's
 // surface of a sample of a's that lies inside b. Only samples farther than the tolerance
 // (and than the deepest so far) from b's surface are asked whether they are inside.
-// `common`: where the two parts' boxes overlap, in the product's frame.
+// `common`: where the two parts' boxes overlap, in the product's frame. Every sample deeper
+// than the tolerance goes into `inside` (product frame).
 double depth_into(const Solid& a, const Pose& a_pose, const Solid& b, const Pose& b_pose,
-                  const Eigen::AlignedBox3d& common, double tolerance) {
+                  const Eigen::AlignedBox3d& common, double tolerance, std::vector<Vec3>& inside) {
   if (!b.inside) return 0;
   const Pose to_b = b_pose.inverse();
   double deepest = 0;
@@ -32,8 +33,9 @@ double depth_into(const Solid& a, const Pose& a_pose, const Solid& b, const Pose
     // Samples come a triangle at a time: the last nearest point is a good hint.
     hint = b.surface->closest_point(sim::solid_point(p), hint);
     const double distance = std::sqrt(CGAL::squared_distance(sim::solid_point(p), hint));
-    if (distance <= std::max(tolerance, deepest)) continue;
-    if (b.contains(sim::solid_point(p))) deepest = distance;
+    if (distance <= tolerance || !b.contains(sim::solid_point(p))) continue;
+    deepest = std::max(deepest, distance);
+    inside.push_back(in_product);
   }
   return deepest;
 }
@@ -89,9 +91,10 @@ InterferenceCheck find_interferences(const LoadedProduct& product, const sim::Co
       if (common.isEmpty() || common.sizes().minCoeff() <= tolerance) continue;
       if (clear_to_bullet(i, j) || clear_to_bullet(j, i)) continue;
       const Pose &pi = parts[i].final_pose, &pj = parts[j].final_pose;
-      const double depth = std::max(depth_into(solid(i), pi, solid(j), pj, common, tolerance),
-                                    depth_into(solid(j), pj, solid(i), pi, common, tolerance));
-      if (depth > tolerance) check.overlaps.push_back({i, j, depth});
+      std::vector<Vec3> inside;
+      const double depth = std::max(depth_into(solid(i), pi, solid(j), pj, common, tolerance, inside),
+                                    depth_into(solid(j), pj, solid(i), pi, common, tolerance, inside));
+      if (depth > tolerance) check.overlaps.push_back({i, j, depth, std::move(inside)});
     }
   }
   for (PartIndex i = 0; i < parts.size(); ++i) {

@@ -22,6 +22,9 @@ namespace twin {
 struct Interference {
   PartIndex part1 = 0, part2 = 0;  // part1 < part2
   double depth = 0;                // m, the deepest contact between them
+  // The samples of either part's surface that lie inside the other deeper than the tolerance,
+  // in the product's frame: where they overlap (threads.hpp reads a thread from them).
+  std::vector<Vec3> inside;
 };
 
 struct InterferenceCheck {

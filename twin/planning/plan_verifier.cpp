@@ -24,6 +24,9 @@ constexpr std::size_t kTreeFrom = 64;
 // m between the poses at which a violation's depth is followed along its move, and how many.
 constexpr double kDepthStep = 0.001;
 constexpr int kDepthPoses = 20;
+// rad of the helix between the poses at which the thread is asked: a third of a turn (at half
+// turns a left-hand helix stands where a right-hand one does)
+constexpr double kThreadTurn = 2 * 3.14159265358979323846 / 3;
 
 CGAL::Bbox_3 bbox(const Eigen::AlignedBox3d& b) {
   return {b.min().x(), b.min().y(), b.min().z(), b.max().x(), b.max().y(), b.max().z()};
@@ -460,6 +463,10 @@ class Replay {
       held.offset = step.trajectory.grasp.gripper;
       holding.push_back(held);
     }
+    // Turning into its thread, the part may go into the mate by the thread's overlap.
+    thread_ = {};
+    if (const auto& screw = step.trajectory.screw) thread_ = {parts[step.part].name, parts[screw->mate].name, screw->overlap};
+    double turned = 0;  // rad along the helix since the thread was last asked
     std::optional<Violation> found;
     std::vector<Placed> around = obstacles();
     bool released = false;
@@ -473,11 +480,40 @@ class Replay {
       }
       found = w[i].holding ? along(holding, w[i - 1].part, w[i].part, around, w[i].phase)
                            : along(alone, w[i - 1].gripper, w[i].gripper, around, w[i].phase);
+      if (!found && w[i].phase == "screw") {
+        turned += Eigen::Quaterniond(w[i - 1].part.linear()).angularDistance(Eigen::Quaterniond(w[i].part.linear()));
+        if (turned >= kThreadTurn - 1e-9) {
+          turned = 0;
+          found = in_thread(holding, w[i].part, around);
+        }
+      }
     }
     if (!released && !w.empty()) {
       for (const auto& [p, offset] : carried) placed_[p] = w.back().part * offset;
     }
     return found;
+  }
+
+  // Turning in its thread, the part overlaps the mate by no more than the thread does in the
+  // finished product (its depth and the resolution): asked every third of a turn, it tells a
+  // helix off the thread's axis, pitch or hand from one on it.
+  std::optional<Violation> in_thread(const std::vector<Body>& members, const Pose& pose, const std::vector<Placed>& around) {
+    for (const Body& m : members) {
+      if (m.name != thread_.part) continue;
+      const Pose at = pose * m.offset;
+      for (const Placed& o : around) {
+        if (o.body->name != thread_.mate) continue;
+        for (const auto& a : *m.shapes) {
+          for (const auto& b : *o.body->shapes) {
+            const double floor = thread_.overlap + options_.resolution;
+            if (auto deep = deeper(*a, at, *b, o.pose, floor, false)) {
+              return Violation{0, "screw", m.name, o.body->name, deep->depth, deep->point, {}, !a->closed() || !b->closed()};
+            }
+          }
+        }
+      }
+    }
+    return std::nullopt;
   }
 
   // Whether the parts in place stand once the arm has let go of the step's part: its
@@ -513,6 +549,9 @@ class Replay {
       const Eigen::AlignedBox3d box = moved_box(m.box, at);
       for (const Placed& o : around) {
         if (!box.intersects(o.box)) continue;
+        // Turning in its thread, the part overlaps its mate by the thread: that pair is asked
+        // every third of a turn (in_thread), not here.
+        if (phase == "screw" && m.name == thread_.part && o.body->name == thread_.mate) continue;
         shapes_near(o, box);
         for (const auto& a : *m.shapes) {
           const Eigen::AlignedBox3d a_box = moved_box(a->box(), at);
@@ -625,19 +664,26 @@ class Replay {
 
   std::optional<Violation> along(const std::vector<Body>& members, const Pose& from, const Pose& to,
                                  const std::vector<Placed>& around, const std::string& phase) {
-    double radius = 0;
-    for (const Body& m : members) {
+    const auto radius_of = [](const Body& m) {
+      double radius = 0;
       for (const auto& s : *m.shapes) radius = std::max(radius, m.offset.translation().norm() + s->radius());
-    }
+      return radius;
+    };
+    double radius = 0;
+    for (const Body& m : members) radius = std::max(radius, radius_of(m));
     const double angle = Eigen::Quaterniond(from.linear()).angularDistance(Eigen::Quaterniond(to.linear()));
     const Vec3 shift = to.translation() - from.translation();
     const double travel = shift.norm() + angle * radius;
     const double step = options_.resolution;
     if (angle > 1e-12) {
-      // Turning: pose by pose, no point moving more than the resolution between them.
-      const int n = std::max(1, static_cast<int>(std::ceil(travel / step)));
-      for (int k = 1; k <= n; ++k) {
-        if (auto v = at_pose(members, sim::interpolate(from, to, double(k) / n), around, phase)) return v;
+      // Turning: pose by pose, no point of a member moving more than the resolution between
+      // them (each member at its own poses: the part near the axis needs far fewer than the
+      // gripper's carriage).
+      for (const Body& m : members) {
+        const int n = std::max(1, static_cast<int>(std::ceil((shift.norm() + angle * radius_of(m)) / step)));
+        for (int k = 1; k <= n; ++k) {
+          if (auto v = at_pose({m}, sim::interpolate(from, to, double(k) / n), around, phase)) return v;
+        }
       }
       return std::nullopt;
     }
@@ -733,6 +779,10 @@ class Replay {
   std::optional<StabilityAnalysis> own_stability_;
   const StabilityAnalysis* stability_ = nullptr;
   std::vector<PartIndex> held_;  // by the plan's fixtures
+  struct {
+    std::string part, mate;  // the step's part turned into the mate's thread (Trajectory::screw)
+    double overlap = 0;      // m, the thread's in the finished product
+  } thread_;
 };
 
 }  // namespace

@@ -1,0 +1,148 @@
+// Threaded joints: a nut modelled with its thread overlaps its bolt's all round the axis by
+// less than a thread's depth. It is taken as a thread, not an interference, and turned on
+// along a helix; a plain ring on a plain rod with the same overlap is not. The replay asks the thread every
+// third of a turn: a helix off the thread's axis, or of the other hand, fails it.
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "tests/support/meshes.hpp"
+#include "tests/twin/test_support.hpp"
+#include "twin/planning/assembly_planner.hpp"
+#include "twin/planning/plan_verifier.hpp"
+#include "twin/planning/threads.hpp"
+
+namespace {
+
+constexpr double kPitch = 0.002;    // m: M16's coarse pitch
+constexpr double kRoot = 0.006;     // m: the bolt's radius at its thread's roots
+constexpr double kHeight = 0.001;   // m: its crests stand this far out
+constexpr double kOverlap = 0.0004; // m: the nut's thread reaches this far into the bolt's
+
+// 0 at a root, 1 at a crest, along a right-hand thread.
+double ridge(double t, double y) {
+  const double u = (y + kPitch * t / (2 * M_PI)) / kPitch;
+  return std::abs(2 * (u - std::floor(u)) - 1);
+}
+
+struct Made {
+  twin::LoadedProduct loaded{twin::Product("made", "made.aml"), {}, {}};
+  Made& part(const std::string& name, sim::TriangleMesh mesh) {
+    twin::DigitalPart p;
+    p.id = p.name = name;
+    loaded.product.add_part(p);
+    loaded.meshes.push_back(std::make_shared<const sim::TriangleMesh>(std::move(mesh)));
+    return *this;
+  }
+};
+
+// Plain: a rod to the thread's crests.
+sim::TriangleMesh bolt(bool threaded = true) {
+  return test::revolved_tube(
+      48, 120, 0.0, 0.030, [threaded](double t, double y) { return kRoot + kHeight * (threaded ? ridge(t, y) : 1); },
+      [](double, double) { return 0.0; });
+}
+
+// Its thread `overlap` into the bolt's, from 14 to 22 mm up; plain: a ring bored to the
+// crests' radius less the overlap.
+sim::TriangleMesh nut(bool threaded) {
+  return test::revolved_tube(
+      48, 32, 0.014, 0.022, [](double, double) { return 0.012; },
+      [threaded](double t, double y) {
+        return (threaded ? kRoot + kHeight * ridge(t, y) : kRoot + kHeight) - kOverlap;
+      });
+}
+
+}  // namespace
+
+TEST_CASE("threads: a nut modelled with its thread into its bolt's is a thread round the bolt's axis, a plain ring on a plain rod is not",
+          "[threads]") {
+  Made threaded;
+  threaded.part("bolt", bolt()).part("nut", nut(true));
+  const auto check = twin::find_interferences(threaded.loaded);
+  REQUIRE(check.overlaps.size() == 1);
+  const auto thread = twin::thread_of(threaded.loaded, check.overlaps.front());
+  REQUIRE(thread);
+  CHECK(std::abs(thread->axis.dot(twin::Vec3::UnitY())) == Approx(1).margin(1e-3));
+  CHECK(thread->centre.x() == Approx(0).margin(2e-4));
+  CHECK(thread->centre.z() == Approx(0).margin(2e-4));
+  CHECK(thread->diameter == Approx(2 * (kRoot + kHeight)).margin(5e-4));
+  CHECK(thread->pitch == Approx(kPitch));
+  CHECK(thread->pitch_assumed);
+  CHECK(thread->length == Approx(0.008).margin(1e-3));
+  CHECK(twin::describe(threaded.loaded.product, *thread).rfind("nut in bolt: a thread of 14.", 0) == 0);
+
+  // A plain ring on a plain rod overlaps as much, and has no thread.
+  Made plain;
+  plain.part("bolt", bolt(false)).part("nut", nut(false));
+  const auto overlaps = twin::find_interferences(plain.loaded).overlaps;
+  REQUIRE(overlaps.size() == 1);
+  CHECK_FALSE(twin::thread_of(plain.loaded, overlaps.front()));
+}
+
+TEST_CASE("threads: the nut is turned onto the bolt along the thread and verified, a helix off the axis or of the other hand is not",
+          "[threads][planning]") {
+  Made m;
+  m.part("bolt", bolt()).part("nut", nut(true));
+  twin::SearchSequencePlanner sequence;
+  twin::LinearPathPlanner path;
+  const twin::Plan plan = twin::plan_assembly(m.loaded, sequence, path);
+  for (const auto& f : plan.findings) UNSCOPED_INFO(f.kind + ": " + f.message);
+  REQUIRE(plan.complete);
+  REQUIRE(plan.steps.size() == 2);
+  CHECK(plan.verification.passed);
+  const twin::PlanStep& step = plan.steps[1];
+  CHECK(m.loaded.product.parts()[step.part].name == "nut");
+  REQUIRE(step.trajectory.screw);
+  CHECK(step.trajectory.screw->mate == 0);
+  CHECK(step.trajectory.direction.y() == Approx(-1));  // down the bolt
+  // From above the bolt's top (30 mm) to its place (14 mm), and a turn's lead-in.
+  CHECK(step.trajectory.screw->turns * kPitch == Approx(0.030 - 0.014 + kPitch).margin(5e-4));
+  const auto& w = step.trajectory.waypoints;
+  CHECK(std::count_if(w.begin(), w.end(), [](const twin::Waypoint& p) { return p.phase == "screw"; }) > 36 * 8);
+  CHECK(std::any_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) { return f.kind == "thread"; }));
+
+  SECTION("the same helix 1 mm off the thread's axis goes into the bolt") {
+    twin::Plan off = plan;
+    for (auto& p : off.steps[1].trajectory.waypoints) {
+      if (p.phase != "screw") continue;
+      p.part.translation().x() += 0.001;
+      p.gripper.translation().x() += 0.001;
+    }
+    const auto v = twin::verify_plan(m.loaded, off);
+    REQUIRE(v.violations.size() == 1);
+    CHECK(v.violations[0].member == "nut");
+    CHECK(v.violations[0].step == 2);
+    CHECK(v.violations[0].phase == "screw");
+    CHECK(v.violations[0].with == "bolt");
+  }
+  SECTION("turned the wrong way, a left-hand helix goes into the bolt") {
+    twin::Plan left = plan;
+    const auto& final_pose = m.loaded.product.parts()[1].final_pose;
+    for (auto& p : left.steps[1].trajectory.waypoints) {
+      if (p.phase != "screw") continue;
+      // The same height, the turn mirrored: R(-a) where the plan has R(a).
+      const Eigen::AngleAxisd turn((final_pose.linear().transpose() * p.part.linear()));
+      const twin::Pose grip = p.part.inverse() * p.gripper;
+      p.part.linear() = Eigen::AngleAxisd(-turn.angle(), turn.axis()).toRotationMatrix();
+      p.gripper = p.part * grip;
+    }
+    const auto v = twin::verify_plan(m.loaded, left);
+    REQUIRE(v.violations.size() == 1);
+    CHECK(v.violations[0].member == "nut");
+    CHECK(v.violations[0].phase == "screw");
+    CHECK(v.violations[0].with == "bolt");
+  }
+}
+
+TEST_CASE("threads: a plain ring overlapping a plain rod is an interference, and no plan holds both", "[threads][planning]") {
+  Made m;
+  m.part("bolt", bolt(false)).part("nut", nut(false));
+  twin::SearchSequencePlanner sequence;
+  twin::LinearPathPlanner path;
+  const twin::Plan plan = twin::plan_assembly(m.loaded, sequence, path);
+  CHECK_FALSE(plan.complete);
+  CHECK(plan.steps.size() == 1);
+  CHECK(std::none_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) { return f.kind == "thread"; }));
+}
