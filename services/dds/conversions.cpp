@@ -134,6 +134,8 @@ fb::Data to_data(const cell::Command& c) {
           {"path", to_numbers(c.path())},
           {"opening", c.opening()},
           {"carried", names(c.carried())},
+          {"turns", c.turns()},
+          {"pitch", c.pitch()},
           {"sim_time", c.sim_time()}};
 }
 
@@ -152,6 +154,8 @@ cell::Command to_command(const fb::Data& d) {
   c.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
   c.opening(fb::get_or<double>(d, "opening", 0));
   c.carried(ids(d, "carried"));
+  c.turns(fb::get_or<double>(d, "turns", 0));
+  c.pitch(fb::get_or<double>(d, "pitch", 0));
   c.sim_time(fb::get_or<double>(d, "sim_time", 0));
   return c;
 }
@@ -190,6 +194,8 @@ cell::SimRequest to_sim_request(const fb::Data& d) {
   r.path(to_path(fb::get_or<fb::Numbers>(d, "path", {})));
   r.speed(fb::get_or<double>(d, "speed", 0));
   r.angular_speed(fb::get_or<double>(d, "angular_speed", 0));
+  r.turning(id(d, "turning"));
+  r.into(id(d, "into"));
   return r;
 }
 
@@ -213,7 +219,9 @@ fb::Data to_data(const cell::SimRequest& r) {
           {"carried", names(r.carried())},
           {"path", to_numbers(r.path())},
           {"speed", r.speed()},
-          {"angular_speed", r.angular_speed()}};
+          {"angular_speed", r.angular_speed()},
+          {"turning", r.turning().to_string()},
+          {"into", r.into().to_string()}};
 }
 
 cell::SimReply to_sim_reply(const fb::Data& d) {

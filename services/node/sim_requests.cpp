@@ -34,12 +34,14 @@ Data SimRequests::set_static(const std::string& body, bool is_static) {
 }
 
 Data SimRequests::move(const std::string& body, const std::vector<std::string>& carried, const Numbers& path,
-                       double speed, double angular_speed) {
+                       double speed, double angular_speed, const std::string& turning, const std::string& into) {
   Data d = request("move", body);
   d["carried"] = join_names(carried);
   d["path"] = path;
   d["speed"] = speed;
   d["angular_speed"] = angular_speed;
+  d["turning"] = turning;
+  d["into"] = into;
   return d;
 }
 

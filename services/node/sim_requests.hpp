@@ -26,8 +26,9 @@ class SimRequests {
   Data remove(const std::string& body);
   Data ping();
   Data set_static(const std::string& body, bool is_static);
+  // `turning`, `into`: a carried body turned into the thread of another (SimRequest).
   Data move(const std::string& body, const std::vector<std::string>& carried, const Numbers& path, double speed,
-            double angular_speed);
+            double angular_speed, const std::string& turning = "", const std::string& into = "");
 
   // Whether a SIM_REPLY answers the last request made.
   bool answers_last(const Data& reply) const;

@@ -10,10 +10,13 @@ namespace {
 // A subassembly's members: cell-sim moves at most 64 bodies with one, and the arm's palm
 // carries its fingers, its carriage and the gripped part besides.
 constexpr std::size_t kMaxCarried = 60;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMostTurns = 1000;  // a screw's: an M3 screw 500 mm long
+constexpr double kMostPitch = 0.05;  // m: far coarser than any thread
 }  // namespace
 
 ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
-    : DeviceBlock(std::move(name), id, {"grip", "translate", "rotate", "release", "connect", "disconnect"}),
+    : DeviceBlock(std::move(name), id, {"grip", "translate", "rotate", "screw", "release", "connect", "disconnect"}),
       settings_(settings), sim_(id) {
   declare_input("SIM_REPLY", {"request_id", "ok"});
   declare_output("SIM", {"request_id", "kind", "body_id"});
@@ -31,7 +34,12 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
   transition("READY", "START", "READY", [this](const Data&) {
     emit("FAIL", {{"reason", std::string("grip needs one gripper pose and an opening")}});
   }, op("grip"));
-  for (const char* motion : {"translate", "rotate"}) {
+  // A screw turns the held part into the thread of `destination`: it may go into that body by
+  // the thread's overlap, nothing else may.
+  transition("READY", "START", "READY", [this](const Data&) {
+    emit("FAIL", {{"reason", std::string("screw: the arm holds no part to turn")}});
+  }, [this, op](const Data& d) { return op("screw")(d) && held_.empty(); });
+  for (const char* motion : {"translate", "rotate", "screw"}) {
     transition("READY", "START", "MOVING", [this](const Data& d) {
       sim_.act_for(get_or<std::string>(d, "order_id", ""));
       std::vector<std::string> carried = gripper_bodies();
@@ -41,7 +49,9 @@ ArmBlock::ArmBlock(std::string name, std::string id, ArmSettings settings)
         carried.insert(carried.end(), held.begin(), held.end());
       }
       awaited_ = 1;
-      request(sim_.move(gripper_bodies().front(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed));
+      const bool screw = get<std::string>(d, "operation") == "screw";
+      request(sim_.move(gripper_bodies().front(), carried, get<Numbers>(d, "path"), settings_.speed, settings_.angular_speed,
+                        screw ? held_ : "", screw ? get<std::string>(d, "destination") : ""));
     }, op(motion));
   }
   // `destination`: what the part goes into, for the cell's state (CellStore::release).
@@ -103,6 +113,22 @@ void ArmBlock::check(const Data& command, SampleCheck& c) const {
     }
   } else if (operation == "translate" || operation == "rotate") {
     c.poses("path", 1);
+  } else if (operation == "screw") {
+    c.poses("path", 1).text("destination", true).at_least("turns", 0).at_least("pitch", 0);
+    const double turns = get_or<double>(command, "turns", 0), pitch = get_or<double>(command, "pitch", 0);
+    c.require(turns > 0 && turns <= kMostTurns, "turns: must be above 0 and at most " + std::to_string(int(kMostTurns)));
+    c.require(pitch > 0 && pitch <= kMostPitch, "pitch: must be above 0 and at most 0.05 m");
+    if (!c.ok()) return;
+    // The path turns as far as the command says (each pose's turn from the last, summed).
+    const Numbers& path = get<Numbers>(command, "path");
+    double turned = 0;
+    for (std::size_t i = 7; i + 7 <= path.size(); i += 7) {
+      const Eigen::Quaterniond from(numbers_pose({path.begin() + i - 7, path.begin() + i}).linear());
+      turned += from.angularDistance(Eigen::Quaterniond(numbers_pose({path.begin() + i, path.begin() + i + 7}).linear()));
+    }
+    std::ostringstream why;
+    why << "path: turns " << turned / (2 * kPi) << " times, not the " << turns << " the command says";
+    c.require(std::abs(turned - 2 * kPi * turns) <= 0.05 * 2 * kPi * turns + 0.2, why.str());
   } else if (operation == "connect" || operation == "disconnect") {
     c.text("part", true);
   }

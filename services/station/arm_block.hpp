@@ -9,6 +9,9 @@
 //         it (a subassembly's other members), are held from now on
 //   START translate | rotate (path): the palm moves along the path with the fingers, the
 //         carriage and the held part; a collision ends it (FAIL with the contact)
+//   START screw (path, turns, pitch, destination = a body): as a motion, along a helix the
+//         path samples, turning the held part into the thread of `destination`, which it may
+//         go into by the thread's overlap; the path must turn `turns` times
 //   START release: lets go;  connect | disconnect (part): the part becomes an obstacle
 //         (joined to the assembly) or movable again
 //   SIM_REPLY: cell-sim's answers; SIM: requests to cell-sim

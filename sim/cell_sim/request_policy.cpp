@@ -37,6 +37,8 @@ std::string RequestPolicy::well_formed(const fb::Data& d) const {
   } else if (kind == "move") {
     c.poses("path", 1).at_least("speed", 0).at_least("angular_speed", 0).names("carried", kMaxCarried);
     c.require(fb::get_or<double>(d, "speed", 0) > 0, "speed: must be above 0");
+    c.text("turning", false).text("into", false);
+    c.require(text(d, "turning").empty() == text(d, "into").empty(), "turning, into: one without the other");
   }
   return c.error();
 }

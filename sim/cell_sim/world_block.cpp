@@ -86,7 +86,8 @@ void WorldBlock::handle(const fb::Data& d) {
     } else if (kind == "move") {
       const MoveResult r = world_.move({id, fb::split_names(fb::get_or<std::string>(d, "carried", "")),
                                         poses(fb::get<fb::Numbers>(d, "path")), fb::get<double>(d, "speed"),
-                                        fb::get_or<double>(d, "angular_speed", 0)});
+                                        fb::get_or<double>(d, "angular_speed", 0),
+                                        fb::get_or<std::string>(d, "turning", ""), fb::get_or<std::string>(d, "into", "")});
       // A physical move is answered when the sim clock reaches its end. A virtual one is a
       // check, not work of the cell: answered at once, and it takes no sim time.
       if (world_.scene_of(id).empty()) due = start + r.duration;

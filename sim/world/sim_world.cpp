@@ -95,18 +95,34 @@ MoveResult SimWorld::move(const MoveRequest& request) {
       throw SimError("body " + b->spec.id + " is in another scene than " + request.body);
     }
   }
-  const CollisionWorld& world = *scenes_.at(moving.front()->spec.scene).world;
+  const std::string& scene = moving.front()->spec.scene;
+  const CollisionWorld& world = *scenes_.at(scene).world;
+  // A body turned into a thread may go into the thread's body (`ignore`); the others, moved
+  // as `others`, may not.
+  BodyId ignore = -1;
+  if (!request.turning.empty()) {
+    if (std::find(request.carried.begin(), request.carried.end(), request.turning) == request.carried.end()) {
+      throw SimError("turning: " + request.turning + " is not carried by the move");
+    }
+    const Body& into = body(request.into);
+    const auto obstacle = into.obstacle.find(scene);
+    if (obstacle == into.obstacle.end()) throw SimError("into: " + request.into + " is no obstacle in the move's scene");
+    ignore = obstacle->second;
+  }
   // One compound in the frame of the moving body, each member at its offset now.
   const Pose start = moving.front()->spec.pose;
-  MovingBody compound;
+  MovingBody compound, others;
   const double margin = options_.shape_margin;
   std::vector<Pose> offsets;
   for (const Body* b : moving) {
     const Pose offset = offsets.emplace_back(start.inverse() * b->spec.pose);
-    if (b->mesh) {
-      compound.add_mesh(b->spec.id, b->mesh, offset, margin);
-    } else if (!b->spec.half_extents.isZero()) {
-      compound.add_box(b->spec.id, b->spec.half_extents, offset, margin);
+    for (MovingBody* into : {&compound, &others}) {
+      if (into == &others && (ignore < 0 || b->spec.id == request.turning)) continue;
+      if (b->mesh) {
+        into->add_mesh(b->spec.id, b->mesh, offset, margin);
+      } else if (!b->spec.half_extents.isZero()) {
+        into->add_box(b->spec.id, b->spec.half_extents, offset, margin);
+      }
     }
   }
 
@@ -118,7 +134,8 @@ MoveResult SimWorld::move(const MoveRequest& request) {
     const double duration =
         std::max(length / request.speed, request.angular_speed > 0 ? angle / request.angular_speed : 0.0);
     std::optional<Contact> contact;
-    if (!compound.empty()) contact = world.sweep(compound, at, next);
+    if (!compound.empty()) contact = world.sweep(compound, at, next, ignore);
+    if (!contact && !others.empty()) contact = world.sweep(others, at, next);
     const double done = contact ? contact->fraction : 1.0;
     result.distance += done * length;
     result.duration += done * duration;

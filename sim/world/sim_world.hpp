@@ -43,6 +43,9 @@ struct MoveRequest {
   std::vector<Pose> path;            // poses of `body`, after its current one
   double speed = 0;                  // m/s, > 0
   double angular_speed = 0;          // rad/s; 0: turning takes no time
+  // A carried body turned into the thread of `into` (a nut onto its bolt): it may go into that
+  // body (the thread's overlap); the other moving bodies may not. Empty: none.
+  std::string turning, into;
 };
 
 struct MoveResult {

@@ -162,7 +162,7 @@ void check_event_log(const std::vector<json>& events, const std::map<std::string
   for (const auto& [order, plan] : plans) parts += plan["steps"].size();
   for (const auto& e : events) {
     if (e["event"] != "succeeded" || !e.contains("distance")) continue;
-    if (e["operation"] == "rotate") continue;  // turning may take longer than the travel
+    if (e["operation"] == "rotate" || e["operation"] == "screw") continue;  // turning may take longer than the travel
     INFO(e.dump());
     const double distance = e["distance"], duration = e["duration"];
     CHECK(duration == Approx(distance / cell.speed.at(e["resource"])).epsilon(1e-6).margin(1e-9));
@@ -234,6 +234,47 @@ TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "
   CHECK(report.find("fetch order-1/boltA1: ") != std::string::npos);
   CHECK(report.find(" s, succeeded</title>") != std::string::npos);
   CHECK(report.find(" s, aborted</title>") == std::string::npos);
+}
+
+// A real product whose nut is screwed onto its bolt (tests/data/real: IsaacGym's M12 nut and
+// bolt, modelled with their threads): the plan's helix goes to the arm as its own `screw`
+// operation, cell-sim lets the nut into the bolt's thread and nothing else, and the order ends
+// assembled.
+TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm operation of its own", "[process][cell]") {
+  const fs::path dir = scratch("screw");
+  std::string cell = read_text(std::string(DEPLOY_CELLS) + "/default.yaml");
+  cell = cell.substr(0, cell.find("buffers:")) +
+         "buffers:\n  - id: buffer-1\n    position: [2.0, 0, -0.8]\n    stock: {bolt: 2, nut: 2}\n";
+  fs::create_directories(dir);
+  { std::ofstream(dir / "cell.yaml") << cell; }
+  test::clean_stale_dds_segments();
+  const int code = cellctl({"run", "--cell", (dir / "cell.yaml").string(), std::string(REAL_DATA_DIR) +
+                            "/factory-nut-bolt-m12/factory-nut-bolt-m12.aml", "--domain", "203", "--real-time-factor", "50",
+                            "--events", (dir / "events.jsonl").string(), "--out", (dir / "out").string(), "--order", "order-1"},
+                           dir / "cellctl.log");
+  INFO(read_text(dir / "cellctl.log"));
+  REQUIRE(code == 0);
+  const json plan = json::parse(read_text(dir / "out" / "plan.json"));
+  CHECK(plan["complete"] == true);
+  std::vector<std::string> arm;  // the arm's commands for the nut, in order
+  double turning = 0;            // sim s the screw took
+  for (const auto& e : read_events(dir / "events.jsonl")) {
+    if (e["event"] != "succeeded" || e["resource"] != "arm-1" || e["part"] != "order-1/nut") continue;
+    arm.push_back(e["operation"]);
+    if (e["operation"] == "screw") turning = e["duration"];
+  }
+  REQUIRE(arm.size() == 6);
+  CHECK(arm[0] == "grip");
+  CHECK((arm[1] == "translate" || arm[1] == "rotate"));  // to where the threads meet
+  CHECK(std::vector<std::string>(arm.begin() + 2, arm.end()) == std::vector<std::string>{"screw", "release", "translate", "connect"});
+  // The screw took its turns at the arm's angular speed (1 rad/s in the default cell).
+  const auto nut = std::find_if(plan["steps"].begin(), plan["steps"].end(), [](const json& s) { return s["part"] == "nut"; });
+  REQUIRE(nut != plan["steps"].end());
+  const json& screw = (*nut)["screw"];
+  REQUIRE(screw.is_object());
+  CHECK(screw["into"] == "bolt");
+  CHECK(screw["pitch"].get<double>() == Approx(0.00175));
+  CHECK(turning == Approx(2 * M_PI * screw["turns"].get<double>()).epsilon(0.05));
 }
 
 TEST_CASE("cell up: a bad order fails alone, one with a subassembly is built, the cell stays idle and usable, down ends it", "[process][cell]") {

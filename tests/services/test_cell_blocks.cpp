@@ -240,24 +240,46 @@ TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the fi
   world.spawn({"pad", "", Eigen::Vector3d(0.01, 0.01, 0.01), sim::Pose(Eigen::Translation3d(0, 0.5, 0)), false, "", false});
   world.spawn({"box", "", Eigen::Vector3d(0.02, 0.02, 0.02), sim::Pose(Eigen::Translation3d(0, 0.47, 0)), false, "", false});
 
-  const sim::MoveResult free = world.move({"pad", {"box"}, {sim::Pose(Eigen::Translation3d(0.3, 0.5, 0.4))}, 0.25, 1});
+  const sim::MoveResult free = world.move({"pad", {"box"}, {sim::Pose(Eigen::Translation3d(0.3, 0.5, 0.4))}, 0.25, 1, "", ""});
   CHECK_FALSE(free.collided);
   CHECK(free.distance == Approx(0.5));
   CHECK(free.duration == Approx(2.0));
   CHECK(world.pose("box")->translation().isApprox(Eigen::Vector3d(0.3, 0.47, 0.4)));  // carried along
 
   // Straight down into the table: the box (carried, 0.03 below the pad) hits it first.
-  const sim::MoveResult hit = world.move({"pad", {"box"}, {sim::Pose(Eigen::Translation3d(0.3, 0.0, 0.4))}, 0.25, 1});
+  const sim::MoveResult hit = world.move({"pad", {"box"}, {sim::Pose(Eigen::Translation3d(0.3, 0.0, 0.4))}, 0.25, 1, "", ""});
   CHECK(hit.collided);
   CHECK(hit.hit_body == "table");
   CHECK(hit.hit_member == "box");
   CHECK(hit.distance == Approx(0.45).margin(0.002));
   CHECK(hit.duration == Approx(hit.distance / 0.25));
 
-  CHECK_THROWS_AS(world.move({"table", {}, {sim::Pose::Identity()}, 1, 1}), sim::SimError);
+  CHECK_THROWS_AS(world.move({"table", {}, {sim::Pose::Identity()}, 1, 1, "", ""}), sim::SimError);
   CHECK_THROWS_AS(world.spawn({"pad", "", Eigen::Vector3d::Zero(), sim::Pose::Identity(), false, "", false}), sim::SimError);
   world.set_static("box", true);
   CHECK(world.is_static("box"));
+}
+
+TEST_CASE("cell-sim world: a body turned into a thread may go into its mate, what moves with it may not", "[sim][world]") {
+  sim::SimWorld world;
+  // A bolt's stand-in (static), a nut that overlaps it 0.5 mm all along, a pad that carries it.
+  world.spawn({"bolt", "", Eigen::Vector3d(0.006, 0.02, 0.006), sim::Pose(Eigen::Translation3d(0, 0.02, 0)), true, "", false});
+  world.spawn({"nut", "", Eigen::Vector3d(0.012, 0.004, 0.012), sim::Pose(Eigen::Translation3d(0, 0.030, 0)), false, "", false});
+  world.spawn({"pad", "", Eigen::Vector3d(0.004, 0.004, 0.004), sim::Pose(Eigen::Translation3d(0.02, 0.040, 0)), false, "", false});
+  const sim::Pose turned_down(Eigen::Translation3d(0.02, 0.035, 0) * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()));
+  const sim::MoveResult plain = world.move({"pad", {"nut"}, {turned_down}, 0.25, 1, "", ""});
+  CHECK(plain.collided);  // the nut is in the bolt from the start
+  CHECK(plain.hit_member == "nut");
+  const sim::MoveResult screwed = world.move({"pad", {"nut"}, {turned_down}, 0.25, 1, "nut", "bolt"});
+  CHECK_FALSE(screwed.collided);
+  CHECK(screwed.duration == Approx(0.5));  // half a radian at 1 rad/s
+  // The pad, which does not turn into the thread, hits the bolt: its check keeps the bolt.
+  const sim::Pose pad_into_bolt(Eigen::Translation3d(0.0, 0.035, 0));
+  const sim::MoveResult pad = world.move({"pad", {"nut"}, {pad_into_bolt}, 0.25, 1, "nut", "bolt"});
+  CHECK(pad.collided);
+  CHECK(pad.hit_member == "pad");
+  CHECK_THROWS_AS(world.move({"pad", {}, {turned_down}, 0.25, 1, "nut", "bolt"}), sim::SimError);  // not carried
+  CHECK_THROWS_AS(world.move({"pad", {"nut"}, {turned_down}, 0.25, 1, "nut", "pad"}), sim::SimError);  // no obstacle
 }
 
 TEST_CASE("device: work queued for an order that has ended fails at once", "[fb][device]") {
@@ -335,8 +357,24 @@ TEST_CASE("device: a malformed command is refused with the field, never started"
   CHECK(arm_refusal(f, "grip", with(with(kGrasp, "part", std::string()), "carried", std::string("o1/B2"))) ==
         "carried: bodies carried with no part gripped");
   CHECK(arm_refusal(f, "grip", with(kGrasp, "sim_time", nan)) == "sim_time: nan is not finite");
-  CHECK(f.block().refused() == 17);
-  CHECK(f.block().last_refusal().find("sim_time: nan is not finite") != std::string::npos);
+  // A screw: its turns, pitch and the body it turns into, and a path that turns as far.
+  fb::Numbers helix;
+  for (int k = 0; k <= 36; ++k) {
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(k * M_PI / 18, Eigen::Vector3d::UnitY()));
+    helix.insert(helix.end(), {0.1, 0.2 - 0.002 * k / 36, 0.3, q.w(), q.x(), q.y(), q.z()});
+  }
+  fb::Data screw = move;
+  screw["path"] = helix;
+  screw["turns"] = 1.0;
+  screw["pitch"] = 0.002;
+  screw["destination"] = std::string("o1/bolt");
+  CHECK(arm_refusal(f, "screw", screw).empty());
+  CHECK(arm_refusal(f, "screw", with(screw, "turns", 3.0)) == "path: turns 1 times, not the 3 the command says");
+  CHECK(arm_refusal(f, "screw", with(screw, "turns", 0.0)) == "turns: must be above 0 and at most 1000");
+  CHECK(arm_refusal(f, "screw", with(screw, "pitch", nan)) == "pitch: nan is not finite");
+  CHECK(arm_refusal(f, "screw", with(screw, "destination", std::string())) == "destination: empty");
+  CHECK(f.block().refused() == 21);
+  CHECK(f.block().last_refusal().find("destination: empty") != std::string::npos);
   // A refused command was never taken: starting it finds nothing.
   CHECK(fb::get<std::string>(f.send("START", {{"command_id", std::string("c3")}})[0].data, "reason") == "unknown command");
 }

@@ -13,6 +13,8 @@
 namespace twin {
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 using fb::Data;
 using fb::get;
 using fb::Numbers;
@@ -228,13 +230,17 @@ std::vector<double> OrderOrchestrator::arm_times() const {
   for (const auto& step : plan_.steps) {
     const auto& w = step.trajectory.waypoints;
     std::vector<Pose> poses;
-    for (const auto& p : w) poses.push_back(p.gripper);
+    for (const auto& p : w) {
+      if (p.phase != "screw") poses.push_back(p.gripper);  // a helix is timed by its turns, below
+    }
     // From the dock (or where its subassembly stands aside) to where the trajectory starts,
     // along it, and back.
     const SubassemblyPlan* unit = inserts_unit(step) ? subassembly_of(step) : nullptr;
     const Vec3 from = unit ? aside_pose(step.part, *unit).translation() : Vec3(dock[0], dock[1], dock[2]);
     const double to_start = (w.front().part.translation() - from).norm();
-    out.push_back((2 * to_start + path_length(poses)) / speed);
+    // A screw's helix takes as long as its turns at the arm's angular speed, where that is longer.
+    const double turning = step.trajectory.screw ? 2 * kPi * step.trajectory.screw->turns / settings_.arm_angular_speed : 0;
+    out.push_back((2 * to_start + path_length(poses)) / speed + turning);
   }
   return out;
 }
@@ -476,7 +482,10 @@ OrderOrchestrator::Carry OrderOrchestrator::carry(const std::string& station, st
   const double least = carry_height(index, w.front().part) + places_.at(station).position[1];
   Carry c;
   for (const Pose& p : lift_over(standing, at(station, w.front().part), least)) c.holding.push_back(p * grip);
-  for (std::size_t i = 1; i < w.size(); ++i) (w[i].holding ? c.holding : c.retreat).push_back(at(station, w[i].gripper));
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    (w[i].holding ? c.holding : c.retreat).push_back(at(station, w[i].gripper));
+    if (w[i].phase == "screw") ++c.turning;
+  }
   return c;
 }
 
@@ -577,12 +586,22 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   }
   spawned_.insert(body);
   spawned_.insert(gripper.begin(), gripper.end());
-  const auto [holding, retreat] = carry(virtual_station_, step, t, standing);
+  const auto [holding, retreat, turning] = carry(virtual_station_, step, t, standing);
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
-  // The palm leads; the fingers, the carriage and (while held) the part go with it.
+  // The palm leads; the fingers, the carriage and (while held) the part go with it; along a
+  // helix at the end, the part turns into its mate's thread.
   std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
   carried.push_back(body);
-  actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers(holding), v, omega), true});
+  const auto thread_start = holding.end() - static_cast<std::ptrdiff_t>(t.screw ? turning : 0);
+  if (thread_start != holding.begin()) {
+    actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers({holding.begin(), thread_start}), v, omega),
+                        true});
+  }
+  if (thread_start != holding.end()) {
+    actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers({thread_start, holding.end()}), v, omega,
+                                               body, virtual_body(t.screw->mate)),
+                        true});
+  }
   carried.pop_back();
   if (!retreat.empty()) {
     actions_.push_back({Action::sim, sim_.move(gripper.front(), carried, pose_numbers(retreat), v, omega), true});
@@ -622,7 +641,7 @@ void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t
                                                 {h.x(), h.y(), h.z()}, false, "", scene)});
   }
   spawned_.insert(gripper.begin(), gripper.end());
-  const auto [holding, retreat] = carry(virtual_station_, step, t, standing);
+  const auto [holding, retreat, turning] = carry(virtual_station_, step, t, standing);
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
   std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
   for (PartIndex member : members) carried.push_back(virtual_body(member));
@@ -713,13 +732,25 @@ void OrderOrchestrator::back_to_sequence_planning() {
 // After the grip: move along the gripper's poses while holding, release, back out, connect.
 // A step that holds its part (PlanStep::hold: it stands only once fastened) connects before
 // the release, the gripper still on the part.
-void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, const std::vector<Pose>& holding,
-                                      const std::vector<Pose>& retreat, const std::string& aside, bool hold) {
+void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, const Carry& carry, const std::string& aside,
+                                      bool hold, const Screw* screw, const std::string& into) {
+  const std::size_t turning = screw ? carry.turning : 0;
+  const std::vector<Pose> holding(carry.holding.begin(), carry.holding.end() - static_cast<std::ptrdiff_t>(turning));
   const bool turns = std::any_of(holding.begin(), holding.end(),
                                  [&](const Pose& p) { return !p.linear().isApprox(holding.front().linear(), 1e-9); });
-  Data move = command(arm_, turns ? "rotate" : "translate", bodies.front());
-  move["path"] = pose_numbers(holding);
-  actions_.push_back({Action::command, move});
+  if (!holding.empty()) {
+    Data move = command(arm_, turns ? "rotate" : "translate", bodies.front());
+    move["path"] = pose_numbers(holding);
+    actions_.push_back({Action::command, move});
+  }
+  if (turning > 0) {
+    Data turn = command(arm_, "screw", bodies.front());
+    turn["path"] = pose_numbers({carry.holding.end() - static_cast<std::ptrdiff_t>(turning), carry.holding.end()});
+    turn["turns"] = screw->turns;
+    turn["pitch"] = screw->pitch;
+    turn["destination"] = into;
+    actions_.push_back({Action::command, turn});
+  }
   const auto connect = [&] {
     for (const auto& body : bodies) actions_.push_back({Action::command, command(arm_, "connect", body)});
   };
@@ -730,7 +761,7 @@ void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, co
   placed_by_[get<std::string>(release, "command_id")] = {{"part", fb::join_names(bodies)}, {"aside", aside}};
   actions_.push_back({Action::command, release});
   Data back = command(arm_, "translate", bodies.front());
-  back["path"] = pose_numbers(retreat);
+  back["path"] = pose_numbers(carry.retreat);
   actions_.push_back({Action::command, back});
   if (!hold) connect();
 }
@@ -851,8 +882,9 @@ void OrderOrchestrator::plan_physical() {
     take["opening"] = t.grasp.opening;
     take["carried"] = fb::join_names({moved.begin() + 1, moved.end()});
     actions_.push_back({Action::command, take});
-    const auto [holding, retreat] = carry(station_, steps[k], t, standing);
-    add_arm_moves(moved, holding, retreat, unit && !inserts_unit(step) ? unit->name : "", step.hold);
+    const auto into = t.screw ? body_of.find(t.screw->mate) : body_of.end();
+    add_arm_moves(moved, carry(station_, steps[k], t, standing), unit && !inserts_unit(step) ? unit->name : "", step.hold,
+                  into != body_of.end() ? &*t.screw : nullptr, into != body_of.end() ? into->second : "");
   }
   next_action();
 }

@@ -152,15 +152,20 @@ class OrderOrchestrator : public fb::BasicBlock {
   fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
                      const std::string& station, const std::string& sources, long count, double duration) const;
   void start_physical_when_hired();
+  struct Carry {
+    std::vector<Pose> holding, retreat;
+    std::size_t turning = 0;  // the last this many of `holding` turn the part into a thread
+  };
   // Scripts.
   void add_candidate(std::size_t step, std::size_t candidate);
   void plan_physical();
   void plan_cleanup();
   void add_unit_candidate(std::size_t step, const Trajectory& t);
   // `bodies`: the gripped one first, then those it carries; `aside`: the subassembly they are
-  // built into aside, "" when they go into the product; `hold`: connected before the release.
-  void add_arm_moves(const std::vector<std::string>& bodies, const std::vector<Pose>& holding,
-                     const std::vector<Pose>& retreat, const std::string& aside, bool hold);
+  // built into aside, "" when they go into the product; `hold`: connected before the release;
+  // `screw`, `into`: the helix at the end of the carry turns the part into that body's thread.
+  void add_arm_moves(const std::vector<std::string>& bodies, const Carry& carry, const std::string& aside, bool hold,
+                     const Screw* screw = nullptr, const std::string& into = "");
   fb::Data command(const std::string& resource, const std::string& operation, const std::string& part = "");
   // Running them.
   void next_action();
@@ -187,9 +192,6 @@ class OrderOrchestrator : public fb::BasicBlock {
   // The gripper's poses at `station` for step `index`'s part gripped where it stands
   // (`standing`) and carried along `t`: held (up, over what stands, down to the start, along
   // it), then after the release (backing out). Virtual and physical assembly carry alike.
-  struct Carry {
-    std::vector<Pose> holding, retreat;
-  };
   Carry carry(const std::string& station, std::size_t index, const Trajectory& t, const Pose& standing) const;
   // The least height (product frame) at which the part of step `index`, at `pose` turned, and
   // what it carries are carried over what stands: the parts its steps before put in the

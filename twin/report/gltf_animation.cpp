@@ -218,7 +218,9 @@ GltfAnimation gltf_animation(const LoadedProduct& loaded, const Plan& plan, cons
     for (std::size_t i = 1; i < w.size(); ++i) {
       const double moved = std::max((w[i].part.translation() - w[i - 1].part.translation()).norm(),
                                     (w[i].gripper.translation() - w[i - 1].gripper.translation()).norm());
-      t += std::max(options.min_segment, moved / options.speed);
+      const double turned = Eigen::Quaterniond(w[i - 1].part.linear()).angularDistance(Eigen::Quaterniond(w[i].part.linear()));
+      const double took = std::max(moved / options.speed, turned / options.angular_speed);
+      t += took > 0 ? took : options.min_segment;
       for (const auto& [p, relative] : moving) key(p, t, w[i].part * relative, 1);
       arm_track.key(t, w[i].gripper, 1);
     }

@@ -18,7 +18,8 @@ namespace twin {
 
 struct AnimationOptions {
   double speed = 0.1;         // m/s of the part along its trajectory
-  double min_segment = 0.25;  // s, for segments that do not move the part (release)
+  double angular_speed = 6;   // rad/s of the part turning (a screw: about a turn a second)
+  double min_segment = 0.25;  // s, for segments that neither move nor turn the part (release)
   double gap = 0.5;           // s between steps, while the arm moves to the next part
   fb::GripperGeometry gripper;
 };

@@ -3,6 +3,14 @@
 namespace twin {
 namespace {
 
+// The thread a step turns its part into (Trajectory::screw), or null.
+nlohmann::json screw_json(const Product& product, const Trajectory& t) {
+  if (!t.screw) return nullptr;
+  const Screw& s = *t.screw;
+  return {{"into", product.parts()[s.mate].name}, {"turns", s.turns}, {"pitch", s.pitch},
+          {"axis", {s.axis.x(), s.axis.y(), s.axis.z()}}, {"point", {s.point.x(), s.point.y(), s.point.z()}}};
+}
+
 nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 nlohmann::json quat(const Pose& p) {
   const Quat q(p.linear());
@@ -65,6 +73,7 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
                      {"path_length", step.trajectory.path_length()},
                      {"tries", step.failed.size() + 1},
                      {"hold", step.hold},
+                     {"screw", screw_json(product, step.trajectory)},
                      {"fixture", fixture_names(product, step)},
                      {"failed_tries", failed},
                      {"margin", margin_json(step, plan.margin_reach)},
