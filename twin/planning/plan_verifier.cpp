@@ -678,12 +678,30 @@ class Replay {
     if (angle > 1e-12) {
       // Turning: pose by pose, no point of a member moving more than the resolution between
       // them (each member at its own poses: the part near the axis needs far fewer than the
-      // gripper's carriage).
+      // gripper's carriage). A run of poses whose swept box (both ends' boxes, grown by how far
+      // the turn moves a point) meets no obstacle's is clear whole; the rest is halved.
       for (const Body& m : members) {
-        const int n = std::max(1, static_cast<int>(std::ceil((shift.norm() + angle * radius_of(m)) / step)));
-        for (int k = 1; k <= n; ++k) {
-          if (auto v = at_pose({m}, sim::interpolate(from, to, double(k) / n), around, phase)) return v;
-        }
+        const double reach = radius_of(m);
+        const int n = std::max(1, static_cast<int>(std::ceil((shift.norm() + angle * reach) / step)));
+        const auto pose_at = [&](int k) { return sim::interpolate(from, to, double(k) / n); };
+        const auto may_meet = [&](int k0, int k1) {
+          Eigen::AlignedBox3d box = moved_box(m.box, pose_at(k0) * m.offset);
+          box.extend(moved_box(m.box, pose_at(k1) * m.offset));
+          const double grow = angle * reach * (k1 - k0) / n;
+          box.min().array() -= grow;
+          box.max().array() += grow;
+          return std::any_of(around.begin(), around.end(), [&](const Placed& o) {
+            return !(phase == "screw" && m.name == thread_.part && o.body->name == thread_.mate) && box.intersects(o.box);
+          });
+        };
+        std::optional<Violation> v;
+        const auto check = [&](auto&& self, int k0, int k1) -> bool {  // poses k0+1..k1; true: clear
+          if (!may_meet(k0, k1)) return true;
+          if (k1 - k0 == 1) return !(v = at_pose({m}, pose_at(k1), around, phase));
+          const int mid = (k0 + k1) / 2;
+          return self(self, k0, mid) && self(self, mid, k1);
+        };
+        if (!check(check, 0, n)) return v;
       }
       return std::nullopt;
     }
