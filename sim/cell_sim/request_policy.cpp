@@ -71,6 +71,11 @@ std::string RequestPolicy::problem_with(const fb::Data& d, const SimWorld& world
     for (const std::string& carried : fb::split_names(text(d, "carried"))) {
       if (std::string problem = may_change(carried, d, world); !problem.empty()) return problem;
     }
+    // A part turned into a thread passes into that body: only one of the same order's (never
+    // a fixture, nor another order's part).
+    if (const std::string into = text(d, "into"); !into.empty()) {
+      if (std::string problem = may_change(into, d, world); !problem.empty()) return "into: " + problem;
+    }
   }
   return "";
 }

@@ -448,6 +448,10 @@ TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "
   f.send("HIRED", {{"resource_id", std::string("arm-1")}, {"order_id", std::string("ok1")}});
   CHECK(ask("arm-1", "move", "arm-1/palm", carry).empty());
   CHECK(f.block().world().pose("ok1/B1")->translation().x() == Approx(0.1));
+  // A screw lets its part into one body of its own order only: not through the table.
+  const fb::Data screw = with(with(carry, "turning", std::string("ok1/B1")), "into", std::string("table"));
+  CHECK(ask("arm-1", "move", "arm-1/palm", screw) == "into: table is a fixture of the cell");
+  CHECK(ask("arm-1", "move", "arm-1/palm", with(screw, "into", std::string())) == "turning, into: one without the other");
   CHECK(ask("intruder", "move", "arm-1/palm", carry) == "arm-1/palm belongs to arm-1, not to intruder");
   f.send("ORDER_ENDED", {{"order_id", std::string("ok1")}});
   CHECK_FALSE(f.block().world().pose("ok1/B1"));
