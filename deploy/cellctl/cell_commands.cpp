@@ -42,7 +42,7 @@ struct CellOptions {
   double wait_s = 30;
   std::string state_dir;
   std::string security_dir;
-  std::vector<std::string> interfaces, peers;
+  std::vector<std::string> interfaces, peers, discovery_servers;
 
   CellConfig load() const;
 };
@@ -56,6 +56,8 @@ void add_cell_options(CLI::App* cmd, CellOptions& o) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--interface", o.interfaces, "Use this IPv4 address of the host (repeat), instead of the file's network");
   cmd->add_option("--peer", o.peers, "Look for participants at this IPv4 address too (another host; repeat)");
+  cmd->add_option("--discovery-server", o.discovery_servers, "The cell's discovery servers, IP:PORT (repeat), instead of the file's")
+      ->check(dds::server_address_problem);
 }
 
 fs::path pid_file(int domain) {
@@ -107,6 +109,11 @@ CellConfig CellOptions::load() const {
   if (!security_dir.empty()) c.security_dir = fs::absolute(security_dir);
   if (!interfaces.empty()) c.interfaces = interfaces;
   if (!peers.empty()) c.peers = peers;
+  if (!discovery_servers.empty()) {
+    c.discovery_servers = discovery_servers;
+    c.simple_discovery = false;
+    c.discovery_given = true;
+  }
   if (!state_dir.empty()) {
     c.state_dir = state_dir;
   } else if (const std::string running = running_state_dir(c.domain); !running.empty()) {
@@ -549,6 +556,12 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     cell.check_twin_identities();
     auto orders = orders_of(*submit_options);
     check_identities_for(cell, orders.size());
+    // The cell's processes, a twin per order and cellctl itself.
+    const std::size_t participants = cell_processes(cell, executable_dir()).size() + orders.size() + 1;
+    if (!cell.discovery_given && participants > kSimpleDiscoveryParticipants) {
+      cell.simple_discovery = false;
+      std::cout << participants << " participants, more than simple discovery takes: through a discovery server" << std::endl;
+    }
     CellObserver observer(cell.participant_settings("cellctl"));
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();

@@ -167,6 +167,32 @@ void read_bounds(const std::filesystem::path& file, const YAML::Node& root, Cell
   }
 }
 
+// `discovery: server | simple | {servers: [IP:PORT, ...]}`.
+void read_discovery(const std::filesystem::path& file, const YAML::Node& root, CellConfig& c) {
+  const YAML::Node node = root["discovery"];
+  if (!node) return;
+  c.discovery_given = true;
+  c.simple_discovery = false;
+  if (node.IsScalar()) {
+    const std::string mode = node.as<std::string>();
+    if (mode != "server" && mode != "simple") {
+      throw ConfigError(where(file, node) + ": discovery is 'server', 'simple' or {servers: [IP:PORT, ...]}, not '" + mode + "'");
+    }
+    c.simple_discovery = mode == "simple";
+    return;
+  }
+  known_keys(file, node, {"servers"});
+  read(file, node, "servers", c.discovery_servers);
+  if (c.discovery_servers.empty()) throw ConfigError(where(file, node) + ": discovery: servers lists at least one IP:PORT");
+  for (const auto& s : c.discovery_servers) {
+    try {
+      dds::server_address(s);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(where(file, node["servers"]) + ": " + e.what());
+    }
+  }
+}
+
 }  // namespace
 
 CellConfig read_cell_config(const std::filesystem::path& file) {
@@ -184,7 +210,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
-              "setup_cost", "currency", "standby_twins", "twin_identities", "fixtures"});
+              "setup_cost", "currency", "standby_twins", "twin_identities", "fixtures", "discovery"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -220,6 +246,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     read(file, network, "peers", c.peers);
     if (c.interfaces.empty()) throw ConfigError(where(file, network) + ": network needs the host's interfaces (IPv4 addresses)");
   }
+  read_discovery(file, root, c);
   read(file, root, "standby_twins", c.standby_twins);
   if (c.standby_twins < 0 || c.standby_twins > 16) throw ConfigError(where(file, root["standby_twins"]) + ": standby_twins must be 0..16");
   read(file, root, "twin_identities", c.twin_identities);
@@ -334,8 +361,23 @@ void CellConfig::check_twin_identities() const {
   }
 }
 
+std::vector<std::string> CellConfig::discovery_addresses() const {
+  if (simple_discovery) return {};
+  if (!discovery_servers.empty()) return discovery_servers;
+  const std::string port = ":" + std::to_string(kDiscoveryBasePort + domain);
+  if (interfaces.empty()) return localhost_only ? std::vector<std::string>{"127.0.0.1" + port} : std::vector<std::string>{};
+  // One server on each host: this one's first address and each peer. Sorted, so that every
+  // host numbers them alike (a server's number is its identity).
+  std::set<std::string> hosts(peers.begin(), peers.end());
+  hosts.insert(interfaces.front());
+  std::vector<std::string> out;
+  for (const auto& h : hosts) out.push_back(h + port);
+  return out;
+}
+
 dds::ParticipantSettings CellConfig::participant_settings(const std::string& identity) const {
   dds::ParticipantSettings s;
+  s.discovery.servers = discovery_addresses();
   s.domain_id = domain;
   s.localhost_only = localhost_only && interfaces.empty();
   s.interfaces = interfaces;
@@ -354,6 +396,7 @@ void add_network(std::vector<std::string>& argv, const CellConfig& c) {
   for (const auto& a : c.interfaces) argv.insert(argv.end(), {"--interface", a});
   for (const auto& a : c.peers) argv.insert(argv.end(), {"--peer", a});
   if (c.interfaces.empty() && !c.localhost_only) argv.push_back("--all-interfaces");
+  for (const auto& a : c.discovery_addresses()) argv.insert(argv.end(), {"--discovery-server", a});
 }
 
 // A twin's options that are the cell's, not the order's.
@@ -442,6 +485,20 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     p.argv.insert(p.argv.end(), {"--state-dir", c.state_folder().string()});
     add_network(p.argv, c);
     add_security(p.argv, c);
+  }
+  // The discovery servers on this host's addresses, before the others.
+  const auto servers = c.discovery_addresses();
+  for (std::size_t i = servers.size(); i-- > 0;) {
+    const std::string ip = dds::server_address(servers[i]).first;
+    const bool here = c.interfaces.empty() ? c.localhost_only && ip == "127.0.0.1"
+                                           : std::find(c.interfaces.begin(), c.interfaces.end(), ip) != c.interfaces.end();
+    if (!here) continue;
+    ProcessSpec server{"discovery-" + std::to_string(i), {(bin / "discovery-server").string(), "--domain", domain, "--serve",
+                                                          std::to_string(i)}};
+    add_network(server.argv, c);
+    add_security(server.argv, c);
+    if (!c.security_dir.empty()) server.argv.insert(server.argv.end(), {"--identity", "discovery"});
+    out.insert(out.begin(), server);
   }
   return out;
 }

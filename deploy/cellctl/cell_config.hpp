@@ -16,6 +16,8 @@ namespace cellctl {
 
 using Point = std::array<double, 3>;
 constexpr double kBoundsMargin = 3.0;  // m around the layout, when the file gives no bounds
+constexpr int kDiscoveryBasePort = 11811;  // Fast DDS's (and ROS 2's) discovery server port; + domain
+constexpr std::size_t kSimpleDiscoveryParticipants = 28;  // below simple discovery's 32 indexes
 
 struct StationConfig {
   std::string id = "station-1", arm = "arm-1";
@@ -63,6 +65,16 @@ struct CellConfig {
   // `network: {interfaces: [IP], peers: [IP]}`: instead, only these addresses of the host, and
   // other hosts' to look for participants at (an OEM's client, the cell's other hosts).
   std::vector<std::string> interfaces, peers;
+  // `discovery:` how the cell's participants find each other (docs/topics.md). `simple` (the
+  // default): each announces itself to a fixed range of ports (at most 32 participants on a
+  // host; the quickest for a small cell). `server`: through discovery servers at port
+  // kDiscoveryBasePort + domain, one on 127.0.0.1, or with `network:` one on each host (the
+  // first interface and each peer); cellctl starts those on its own addresses.
+  // `{servers: [IP:PORT, ...]}`: through these. Without the key, `cellctl run` takes `server`
+  // when its orders would bring more than kSimpleDiscoveryParticipants participants.
+  bool simple_discovery = true;
+  bool discovery_given = false;  // the file (or the command line) said which
+  std::vector<std::string> discovery_servers;  // given in the file; empty: the default
   std::vector<StationConfig> stations{StationConfig{}};
   std::vector<RobotConfig> robots{RobotConfig{}};
   std::vector<BufferConfig> buffers;
@@ -98,6 +110,8 @@ struct CellConfig {
   int twin_identities = 10;
 
   std::vector<std::string> resource_ids() const;
+  // The servers every participant of the cell uses ("IP:PORT"); empty: simple discovery.
+  std::vector<std::string> discovery_addresses() const;
   std::vector<std::string> twin_identity_names() const;  // twin-1 .. twin-N
   std::vector<std::string> twin_identities_in_use() const;  // those with security, none without
   // With security: throws ConfigError naming an identity of twin_identities that the
@@ -123,7 +137,8 @@ struct ProcessSpec {
   bool others_depend = false;
 };
 
-// cell-sim first (the others wait for it), then the station, the robot, the buffers.
+// The discovery servers on this host first, then cell-sim (the others wait for it), then the
+// stations, the robots, the buffers.
 std::vector<ProcessSpec> cell_processes(const CellConfig& cell, const std::filesystem::path& bin_dir);
 
 // The twin of one order on the cell (`quote`: an order for a quote, with the cell's rates;

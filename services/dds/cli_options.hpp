@@ -1,8 +1,9 @@
 #pragma once
 // The DDS options every cell process takes: --domain N (required), --all-interfaces (the
 // deployment file's `localhost_only: false`; without it, loopback only) or --interface IP
-// and --peer IP (its `network:`), and --security DIR with --identity NAME (its
-// `security: DIR`; docs/security.md).
+// and --peer IP (its `network:`), --discovery-server IP:PORT (its `discovery:`; repeated for
+// each of the cell's servers), and --security DIR with --identity NAME (its `security: DIR`;
+// docs/security.md).
 
 #include <CLI/CLI.hpp>
 
@@ -18,6 +19,9 @@ inline void add_dds_options(CLI::App& app, ParticipantSettings& settings, bool& 
   app.add_flag("--all-interfaces", all_interfaces, "Use every network interface, not only loopback");
   app.add_option("--interface", settings.interfaces, "Use this IPv4 address of the host (repeat for more), not loopback");
   app.add_option("--peer", settings.peers, "Look for participants at this IPv4 address too (another host; repeat)");
+  app.add_option("--discovery-server", settings.discovery.servers,
+                 "Find the others through this discovery server, IP:PORT (repeat for each; default: simple discovery)")
+      ->check(server_address_problem);
   app.add_option("--security", settings.security.dir, "DDS-Security: the folder `cellctl pki init` wrote (default: off)");
   app.add_option("--identity", settings.security.identity,
                  "DDS-Security: the identity under DIR/identities (default: the process's name)");

@@ -13,6 +13,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/writer/WriterDiscoveryInfo.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -145,6 +146,40 @@ void reserve_reader_slots(eprosima::fastdds::dds::DomainParticipant& participant
   participant.unregister_type(type.get_type_name());
 }
 
+eprosima::fastrtps::rtps::Locator_t udp_locator(const std::string& participant, const std::string& address, int port) {
+  eprosima::fastrtps::rtps::Locator_t locator;
+  locator.kind = LOCATOR_KIND_UDPv4;
+  if (!eprosima::fastrtps::rtps::IPLocator::setIPv4(locator, address)) {
+    throw std::runtime_error("DDS participant '" + participant + "': '" + address + "' is not an IPv4 address");
+  }
+  locator.port = static_cast<std::uint32_t>(port);
+  return locator;
+}
+
+// A server is known to the others by its address and by a GUID prefix that its place in the
+// list gives (Fast DDS's own scheme, as ROS_DISCOVERY_SERVER uses it): the clients never need
+// to be told a prefix. Servers list each other, so that a client of one learns of the clients
+// of the others, and a client lists them all, so that it goes on when one of them ends.
+void use_discovery_servers(eprosima::fastdds::dds::DomainParticipantQos& qos, const std::string& name,
+                           const DiscoverySettings& discovery) {
+  using namespace eprosima::fastdds::rtps;
+  auto& builtin = qos.wire_protocol().builtin;
+  for (std::size_t i = 0; i < discovery.servers.size(); ++i) {
+    const auto [address, port] = server_address(discovery.servers[i]);
+    RemoteServerAttributes server;
+    get_server_client_default_guidPrefix(static_cast<int>(i), server.guidPrefix);
+    server.metatrafficUnicastLocatorList.push_back(udp_locator(name, address, port));
+    if (static_cast<int>(i) == discovery.serve) {
+      qos.wire_protocol().prefix = server.guidPrefix;
+      builtin.metatrafficUnicastLocatorList.push_back(udp_locator(name, address, port));
+    } else {
+      builtin.discovery_config.m_DiscoveryServers.push_back(server);
+    }
+  }
+  builtin.discovery_config.discoveryProtocol =
+      discovery.serve >= 0 ? eprosima::fastrtps::rtps::DiscoveryProtocol::SERVER : eprosima::fastrtps::rtps::DiscoveryProtocol::CLIENT;
+}
+
 }  // namespace
 
 ParticipantPtr make_participant(const std::string& name, const ParticipantSettings& settings) {
@@ -176,13 +211,8 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
     // never discovered). 32 covers a cell, its twins and cellctl.
     udp->maxInitialPeersRange = kMaxParticipantsPerHost;
     qos.transport().user_transports.push_back(udp);
-    for (const auto& address : peers) {
-      eprosima::fastrtps::rtps::Locator_t peer;
-      peer.kind = LOCATOR_KIND_UDPv4;
-      if (!eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, address)) {
-        throw std::runtime_error("DDS participant '" + name + "': '" + address + "' is not an IPv4 address");
-      }
-      qos.wire_protocol().builtin.initialPeersList.push_back(peer);
+    if (settings.discovery.servers.empty()) {
+      for (const auto& address : peers) qos.wire_protocol().builtin.initialPeersList.push_back(udp_locator(name, address, 0));
     }
   }
   // Announce the participant every 0.5 s instead of 3 s: a first announcement that no one
@@ -193,6 +223,12 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   // dies is noticed by the 5 s liveliness of its capability, not by this lease.
   qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
   qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(20.0);
+  if (settings.discovery.serve >= static_cast<int>(settings.discovery.servers.size())) {
+    throw std::runtime_error("DDS participant '" + name + "': it serves discovery as server " +
+                             std::to_string(settings.discovery.serve) + " of " +
+                             std::to_string(settings.discovery.servers.size()));
+  }
+  if (!settings.discovery.servers.empty()) use_discovery_servers(qos, name, settings.discovery);
   std::string identity;
   if (!settings.security.dir.empty()) {
     identity = settings.security.identity.empty() ? name : settings.security.identity;

@@ -28,6 +28,17 @@ class RequestPolicy {
   std::string problem_with(const fb::Data& request, const SimWorld& world) const;
 
   void hired(const std::string& resource, const std::string& order) { hired_[resource].insert(order); }
+  // A resource of the cell has bodies of its own in the world (a table, a gripper, a base).
+  bool has_bodies(const std::string& requester) const {
+    for (const auto& [body, owner] : owner_) {
+      if (owner == requester) return true;
+    }
+    return false;
+  }
+  bool hired_by(const std::string& resource, const std::string& order) const {
+    const auto it = hired_.find(resource);
+    return it != hired_.end() && it->second.count(order);
+  }
   void spawned(const std::string& body, const std::string& requester) { owner_[body] = requester; }
   void removed(const std::string& body) { owner_.erase(body); }
   // Who spawned the body ("" when no one did).

@@ -21,8 +21,10 @@ std::vector<Pose> poses(const fb::Numbers& n) {
 
 }  // namespace
 
-WorldBlock::WorldBlock(std::string name, double real_time_factor, fb::CellBounds bounds, double clock_period_s)
-    : FunctionBlock(std::move(name)), factor_(real_time_factor), clock_period_(clock_period_s), policy_(bounds) {
+WorldBlock::WorldBlock(std::string name, double real_time_factor, fb::CellBounds bounds, double clock_period_s,
+                       std::chrono::milliseconds hire_wait)
+    : FunctionBlock(std::move(name)), factor_(real_time_factor), clock_period_(clock_period_s), hire_wait_(hire_wait),
+      policy_(bounds) {
   if (real_time_factor <= 0) throw std::invalid_argument("the real-time factor must be above 0");
   declare_input("REQUEST", {"request_id", "requester", "kind", "body_id"});
   declare_input("TICK");
@@ -45,18 +47,34 @@ void WorldBlock::receive(const fb::Event& event) {
     }
   }
   if (event.name == "HIRED") {
-    policy_.hired(fb::get<std::string>(event.data, "resource_id"), fb::get<std::string>(event.data, "order_id"));
+    const std::string resource = fb::get<std::string>(event.data, "resource_id"), order = fb::get<std::string>(event.data, "order_id");
+    policy_.hired(resource, order);
+    std::vector<Held> waiting;
+    waiting.swap(held_);
+    for (Held& h : waiting) {
+      if (fb::get<std::string>(h.request, "requester") == resource && fb::get_or<std::string>(h.request, "order_id", "") == order) {
+        handle(h.request, false);
+      } else {
+        held_.push_back(std::move(h));
+      }
+    }
   }
   publish_due();
 }
 
-void WorldBlock::handle(const fb::Data& d) {
+void WorldBlock::handle(const fb::Data& d, bool may_wait) {
   const double start = now();
   fb::Data reply{{"request_id", d.at("request_id")}, {"requester", d.at("requester")}, {"ok", true},
                  {"start_time", start}, {"end_time", start}};
   double due = start;
   try {
     if (const std::string problem = policy_.problem_with(d, world_); !problem.empty()) {
+      const std::string order = fb::get_or<std::string>(d, "order_id", ""), requester = fb::get<std::string>(d, "requester");
+      if (may_wait && !order.empty() && !policy_.hired_by(requester, order) && policy_.has_bodies(requester) &&
+          held_.size() < kMaxHeld) {
+        held_.push_back({std::chrono::steady_clock::now() + hire_wait_, d});
+        return;
+      }
       emit("REFUSED", {{"refused", std::int64_t(++refused_)},
                        {"last_refusal", fb::get<std::string>(d, "requester") + " " +
                                             fb::get<std::string>(d, "request_id") + ": " + problem}});
@@ -108,6 +126,11 @@ void WorldBlock::handle(const fb::Data& d) {
 }
 
 void WorldBlock::publish_due() {
+  while (!held_.empty() && held_.front().until <= std::chrono::steady_clock::now()) {
+    const fb::Data request = std::move(held_.front().request);
+    held_.erase(held_.begin());
+    handle(request, false);
+  }
   const double t = now();
   while (!pending_.empty() && pending_.begin()->first <= t) {
     fb::Data reply = std::move(pending_.begin()->second);

@@ -479,18 +479,19 @@ TEST_CASE("a twin that dies mid-order: its reservations lapse, its parts leave c
 namespace {
 
 // Ten orders, Lego towers and Cranfield pendulums in turn, as one `cellctl run`; the plans by order id.
-std::map<std::string, json> run_mixed(const std::string& cell, int domain, const fs::path& dir, std::string& log) {
+std::map<std::string, json> run_mixed(const std::string& cell, int domain, const fs::path& dir, std::string& log,
+                                      int count = 10, std::chrono::seconds limit = 200s) {
   test::clean_stale_dds_segments();
   std::vector<std::string> args{"run", "--cell", cell, "--domain", std::to_string(domain), "--real-time-factor", "50",
                                 "--events", (dir / "events.jsonl").string(), "--out", (dir / "out").string()};
   std::vector<std::string> orders;
-  for (int i = 0; i < 10; ++i) {
+  for (int i = 0; i < count; ++i) {
     const bool lego = i % 2 == 0;
     args.push_back(std::string(PRODUCTS_DIR) + (lego ? "/lego-tower/lego-tower.aml" : "/cranfield/cranfield.aml"));
     const int n = i / 2 + 1;
     orders.push_back(std::string(lego ? "lego-tower" : "cranfield") + (n == 1 ? "" : "-" + std::to_string(n)));
   }
-  const int code = cellctl(args, dir / "cellctl.log", 200s);
+  const int code = cellctl(args, dir / "cellctl.log", limit);
   log = read_text(dir / "cellctl.log");
   INFO(log);
   REQUIRE(code == 0);
@@ -518,6 +519,24 @@ TEST_CASE("many orders: ten mixed orders at once on two stations and two robots"
   CHECK(robots == std::set<std::string>{"mobile-robot-1", "mobile-robot-2"});
   CHECK(log.find("makespan") != std::string::npos);
   for (const auto& [order, plan] : plans) CHECK(log.find(order + " ") != std::string::npos);
+}
+
+// About 57 participants on the host (the cell's 16 processes, 40 twins, cellctl): past simple
+// discovery's 32, through the discovery server. Hidden ([.scale]): ctest runs it as
+// cell_run_scale, skipped under the sanitizers. (At 60, cell-sim's one queue of requests
+// left twins' pings unanswered for 30 s: docs/performance.md, "Discovery".)
+TEST_CASE("many orders: forty at once on four stations, through the discovery server, all assembled", "[.scale][process][cell]") {
+  const fs::path dir = scratch("forty-four-stations");
+  const std::string cell = std::string(DEPLOY_CELLS) + "/four-stations.yaml";
+  std::string log;
+  const auto plans = run_mixed(cell, 229, dir, log, 40, 600s);
+  CHECK(plans.size() == 40);
+  check_event_log(read_events(dir / "events.jsonl"), plans, cell);
+  const std::regex assembled(R"(\n\S+\s+\S+\.aml\s+assembled\s)");
+  CHECK(std::distance(std::sregex_iterator(log.begin(), log.end(), assembled), std::sregex_iterator()) == 40);
+  CHECK(log.find("nobody offered") == std::string::npos);
+  CHECK(log.find("FAILED") == std::string::npos);
+  CHECK(log.find("discovery-0") != std::string::npos);  // the server ran, as a cell process
 }
 
 TEST_CASE("many orders: ten orders on the one-station cell queue, say so, and are all assembled",

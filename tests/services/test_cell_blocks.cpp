@@ -395,7 +395,8 @@ TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "
   fb::CellBounds bounds;
   bounds.min = {-5, -1, -5};
   bounds.max = {5, 3, 5};
-  fb::BlockTestFixture<sim::WorldBlock> f("world", 1000.0, bounds);
+  // A request for an order that has not hired its requester waits 50 ms for the hire here.
+  fb::BlockTestFixture<sim::WorldBlock> f("world", 1000.0, bounds, 0.05, std::chrono::milliseconds(50));
   int count = 0;
   const auto ask = [&](const std::string& requester, const std::string& kind, const std::string& body, fb::Data d) {
     d["request_id"] = "r" + std::to_string(++count);
@@ -448,6 +449,37 @@ TEST_CASE("cell-sim: requests are checked, and an order's bodies are its own", "
   f.send("HIRED", {{"resource_id", std::string("arm-1")}, {"order_id", std::string("ok1")}});
   CHECK(ask("arm-1", "move", "arm-1/palm", carry).empty());
   CHECK(f.block().world().pose("ok1/B1")->translation().x() == Approx(0.1));
+  // A request that overtook its hire (another topic) is carried out when the hire comes.
+  CHECK(ask("arm-2", "spawn", "arm-2/palm", box).empty());
+  fb::Data early = with(carry, "request_id", std::string("early"));
+  early["requester"] = std::string("arm-2");
+  early["kind"] = std::string("move");
+  early["body_id"] = std::string("arm-2/palm");
+  const auto answered = [](const std::vector<fb::Event>& out) {
+    return std::any_of(out.begin(), out.end(), [](const fb::Event& e) {
+      return e.name == "REPLY" && fb::get<std::string>(e.data, "request_id") == "early";
+    });
+  };
+  CHECK_FALSE(answered(f.send("REQUEST", early)));
+  std::vector<fb::Event> out = f.send("HIRED", {{"resource_id", std::string("arm-2")}, {"order_id", std::string("ok1")}});
+  for (int i = 0; i < 1000 && !answered(out); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    out = f.send("TICK");
+  }
+  REQUIRE(answered(out));
+  for (const fb::Event& e : out) {
+    if (e.name == "REPLY") CHECK(fb::get<bool>(e.data, "ok"));
+  }
+  // A requester with no bodies of its own is no resource of the cell: refused at once.
+  fb::Data stranger = with(move, "order_id", std::string("ok1"));
+  stranger["request_id"] = std::string("stranger");
+  stranger["requester"] = std::string("intruder");
+  stranger["kind"] = std::string("move");
+  stranger["body_id"] = std::string("ok1/B1");
+  out = f.send("REQUEST", stranger);
+  CHECK(std::any_of(out.begin(), out.end(), [](const fb::Event& e) {
+    return e.name == "REPLY" && fb::get_or<std::string>(e.data, "error", "") == "ok1/B1 belongs to order ok1, which has not hired intruder";
+  }));
   // A screw lets its part into one body of its own order only: not through the table.
   const fb::Data screw = with(with(carry, "turning", std::string("ok1/B1")), "into", std::string("table"));
   CHECK(ask("arm-1", "move", "arm-1/palm", screw) == "into: table is a fixture of the cell");
