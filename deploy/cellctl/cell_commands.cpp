@@ -114,6 +114,10 @@ CellConfig CellOptions::load() const {
     c.simple_discovery = false;
     c.discovery_given = true;
   }
+  if (!c.security_dir.empty() && !c.simple_discovery) {
+    throw ConfigError(cell + ": discovery through a server does not work with security: on Fast DDS 2.9 a secure cell uses "
+                      "simple discovery (discovery: simple)");
+  }
   if (!state_dir.empty()) {
     c.state_dir = state_dir;
   } else if (const std::string running = running_state_dir(c.domain); !running.empty()) {
@@ -558,7 +562,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     check_identities_for(cell, orders.size());
     // The cell's processes, a twin per order and cellctl itself.
     const std::size_t participants = cell_processes(cell, executable_dir()).size() + orders.size() + 1;
-    if (!cell.discovery_given && participants > kSimpleDiscoveryParticipants) {
+    if (!cell.discovery_given && cell.security_dir.empty() && participants > kSimpleDiscoveryParticipants) {
       cell.simple_discovery = false;
       std::cout << participants << " participants, more than simple discovery takes: through a discovery server" << std::endl;
     }

@@ -277,6 +277,12 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     if (dir.empty()) throw ConfigError(where(file, root["security"]) + ": security names the folder `cellctl pki init` wrote");
     c.security_dir = std::filesystem::absolute(file.parent_path() / dir);
   }
+  // Fast DDS 2.9's servers do not take part in DDS-Security (its secure Discovery Server came
+  // in 2.10): through one, a secure cell's clients never match (measured: the cell never came up).
+  if (!c.security_dir.empty() && !c.simple_discovery) {
+    throw ConfigError(where(file, root["discovery"]) + ": discovery through a server does not work with security: on " +
+                      "Fast DDS 2.9 a secure cell uses simple discovery (discovery: simple)");
+  }
   if (const YAML::Node gripper = root["gripper"]) {
     std::set<std::string> names;
     for (const auto& [name, size] : fb::gripper_sizes()) names.insert(name);
