@@ -58,6 +58,9 @@ void add_cell_options(CLI::App* cmd, CellOptions& o) {
   cmd->add_option("--peer", o.peers, "Look for participants at this IPv4 address too (another host; repeat)");
   cmd->add_option("--discovery-server", o.discovery_servers, "The cell's discovery servers, IP:PORT (repeat), instead of the file's")
       ->check(dds::server_address_problem);
+  cmd->add_option("--wait", o.wait_s, "How long the cell's resources may take to be heard on DDS, s: a twin's wait for "
+                                      "them; for up, at its start and for a process that goes silent (then restarted)")
+      ->check(CLI::PositiveNumber);
 }
 
 fs::path pid_file(int domain) {
@@ -126,14 +129,25 @@ CellConfig CellOptions::load() const {
   return c;
 }
 
-// Until every resource of the file has published its capability; throws naming the missing.
-void wait_for_cell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait) {
+// Until every resource of the file has published its capability; throws naming the missing
+// (`waited`: how long the caller waited in all, when more than `wait`).
+void wait_for_cell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait,
+                   std::chrono::milliseconds waited = 0ms) {
   const auto missing = observer.wait_for_resources(cell.resource_ids(), wait);
   if (missing.empty()) return;
   std::string list;
   for (const auto& m : missing) list += " " + m;
-  throw std::runtime_error("the cell did not come up within " + std::to_string(wait.count() / 1000) +
+  throw std::runtime_error("the cell did not come up within " + std::to_string(std::max(wait, waited).count() / 1000) +
                            " s; missing:" + list);
+}
+
+// The resources alive on DDS now.
+std::set<std::string> heard_resources(const CellObserver& observer) {
+  std::set<std::string> heard;
+  for (const auto& [id, r] : observer.resources()) {
+    if (r.alive) heard.insert(id);
+  }
+  return heard;
 }
 
 // The cell's processes, started in order; cell-sim first, as the others wait for it.
@@ -386,14 +400,23 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
                           });
     // Before the cell is up: a submit that sees the cell's resources finds its state too.
     std::ofstream(pid_file(cell.domain)) << ::getpid() << '\n' << fs::absolute(cell.state_folder()).string() << '\n';
+    const auto wait = std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000));
     try {
       // Until every resource is there. A process that dies meanwhile is restarted like any
       // other (a young process can die in DDS discovery: a restarted robot did so under TSan,
-      // and this up gave the whole cell up).
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000));
-      while (!observer.wait_for_resources(cell.resource_ids(), 500ms).empty()) {
+      // and this up gave the whole cell up), and so is one of ours that runs unheard, once.
+      const auto deadline = std::chrono::steady_clock::now() + wait;
+      std::set<std::string> ended_unheard;
+      for (std::vector<std::string> missing; !(missing = observer.wait_for_resources(cell.resource_ids(), 500ms)).empty();) {
+        for (const std::string& process : supervisor.end_unheard(heard_resources(observer), wait)) {
+          if (!ended_unheard.insert(process).second) {
+            throw std::runtime_error("the cell did not come up: " + process + " was not heard on DDS within " +
+                                     std::to_string(wait.count() / 1000) + " s of its start, twice");
+          }
+        }
         if (const std::string why = supervisor.tend(); !why.empty()) throw std::runtime_error(why);
-        if (std::chrono::steady_clock::now() > deadline) wait_for_cell(cell, observer, 0ms);  // throws naming the missing
+        const bool others_missing = std::any_of(missing.begin(), missing.end(), [&](const std::string& r) { return !supervisor.runs(r); });
+        if (others_missing && std::chrono::steady_clock::now() > deadline) wait_for_cell(cell, observer, 0ms, wait);
       }
     } catch (const std::exception& e) {
       store.journal("cellctl", "down", "", std::string("gave up: ") + e.what());
@@ -412,6 +435,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       world_lost = false;
       remote.tend();
       desk.tend();
+      supervisor.end_unheard(heard_resources(observer), wait);
       if (const std::string why = supervisor.tend(); !why.empty()) {
         std::cerr << "error: " << why << "; stopping the cell. Look at that process's output above, fix the cause, "
                   << "and start the cell again\n";

@@ -458,13 +458,14 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     }
   };
   out.push_back({"cell-sim", {(bin / "cell-sim").string(), "--domain", domain, "--real-time-factor",
-                              std::to_string(c.real_time_factor)}});
+                              std::to_string(c.real_time_factor)},
+                 true, {}});
   add_bounds(out.back().argv);
-  out.back().others_depend = true;
   for (const auto& st : c.stations) {
     ProcessSpec station{st.id, {(bin / "station").string(), "--domain", domain, "--id", st.id, "--arm-id", st.arm,
                                 "--arm-speed", std::to_string(st.arm_speed), "--arm-angular-speed",
-                                std::to_string(st.arm_angular_speed), "--lease", lease}};
+                                std::to_string(st.arm_angular_speed), "--lease", lease},
+                        false, {st.id, st.arm}};
     add_point(station.argv, "--position", st.position);
     add_point(station.argv, "--dock", st.dock);
     add_point(station.argv, "--table", st.table);
@@ -474,12 +475,13 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
   }
   for (const auto& r : c.robots) {
     ProcessSpec robot{r.id, {(bin / "mobile-robot").string(), "--domain", domain, "--id", r.id, "--speed",
-                             std::to_string(r.speed), "--lease", lease}};
+                             std::to_string(r.speed), "--lease", lease},
+                      false, {r.id}};
     add_point(robot.argv, "--home", r.home);
     out.push_back(robot);
   }
   for (const auto& b : c.buffers) {
-    ProcessSpec buffer{b.id, {(bin / "buffer").string(), "--domain", domain, "--id", b.id, "--lease", lease}};
+    ProcessSpec buffer{b.id, {(bin / "buffer").string(), "--domain", domain, "--id", b.id, "--lease", lease}, false, {b.id}};
     add_point(buffer.argv, "--position", b.position);
     for (const auto& [type, count] : b.stock) {
       buffer.argv.push_back("--stock");
@@ -500,7 +502,8 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
                                            : std::find(c.interfaces.begin(), c.interfaces.end(), ip) != c.interfaces.end();
     if (!here) continue;
     ProcessSpec server{"discovery-" + std::to_string(i), {(bin / "discovery-server").string(), "--domain", domain, "--serve",
-                                                          std::to_string(i)}};
+                                                          std::to_string(i)},
+                       false, {}};
     add_network(server.argv, c);
     add_security(server.argv, c);
     if (!c.security_dir.empty()) server.argv.insert(server.argv.end(), {"--identity", "discovery"});

@@ -135,6 +135,7 @@ struct ProcessSpec {
   std::vector<std::string> argv;  // argv[0]: the executable
   // The others hold state in it (cell-sim's world: their bodies): when it restarts, they do too.
   bool others_depend = false;
+  std::vector<std::string> resources;  // the ids of the resources it publishes
 };
 
 // The discovery servers on this host first, then cell-sim (the others wait for it), then the

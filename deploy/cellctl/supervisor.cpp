@@ -7,7 +7,7 @@ namespace cellctl {
 Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log log)
     : policy_(policy), log_(std::move(log)) {
   for (auto& spec : specs) {
-    Child child{std::move(spec), nullptr, {}, {}, 0};
+    Child child{std::move(spec), nullptr, {}, {}, 0, std::chrono::steady_clock::now()};
     child.process = std::make_unique<Process>(child.spec.name, child.spec.argv);
     children_.push_back(std::move(child));
   }
@@ -39,6 +39,7 @@ std::string Supervisor::tend() {
     } else if (now >= c.restart_at) {
       try {
         c.process = std::make_unique<Process>(c.spec.name, c.spec.argv);
+        c.heard_at = std::chrono::steady_clock::now();
         ++c.restarts;
         log_(c.spec.name, "restarted", c.spec.name + " restarted (pid " + std::to_string(c.process->pid()) + ", restart " +
              std::to_string(c.restarts) + ")");
@@ -48,6 +49,31 @@ std::string Supervisor::tend() {
     }
   }
   return "";
+}
+
+std::vector<std::string> Supervisor::end_unheard(const std::set<std::string>& heard,
+                                                 std::chrono::steady_clock::duration silence) {
+  const auto now = std::chrono::steady_clock::now();
+  std::vector<std::string> ended;
+  for (Child& c : children_) {
+    if (!c.process || c.spec.resources.empty()) continue;
+    const bool all_heard = std::all_of(c.spec.resources.begin(), c.spec.resources.end(),
+                                       [&heard](const std::string& r) { return heard.count(r) > 0; });
+    if (all_heard) c.heard_at = now;
+    if (all_heard || now - c.heard_at < silence) continue;
+    const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - c.heard_at).count();
+    log_(c.spec.name, "unheard", c.spec.name + " runs but has not been heard on DDS for " + std::to_string(seconds) +
+                                     " s (hung?); ending it to restart it");
+    c.process->stop(std::chrono::seconds(2));  // tend() finds it ended
+    ended.push_back(c.spec.name);
+  }
+  return ended;
+}
+
+bool Supervisor::runs(const std::string& resource) const {
+  return std::any_of(children_.begin(), children_.end(), [&resource](const Child& c) {
+    return std::find(c.spec.resources.begin(), c.spec.resources.end(), resource) != c.spec.resources.end();
+  });
 }
 
 // The others' state lived in the process that ended (their bodies in cell-sim's world): they

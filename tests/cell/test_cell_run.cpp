@@ -301,7 +301,7 @@ TEST_CASE("cell up: a bad order fails alone, one with a subassembly is built, th
                                 "--domain", domain, "--order", "nested", "--out", (dir / "nested").string()},
                                dir / "nested.log");
     const std::string nested_log = read_text(dir / "nested.log"), up_log = read_text(dir / "up.log");
-    INFO("what went wrong, from the order's and the cell's logs:\n" << test::error_lines(nested_log) << test::error_lines(up_log));
+    INFO("what went wrong, from the cell's and the order's logs:\n" << test::error_lines(up_log) << test::error_lines(nested_log));
     INFO(nested_log << up_log);
     CHECK(nested == 0);
     CHECK(nested_log.find("assembled 9 parts") != std::string::npos);

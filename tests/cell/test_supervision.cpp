@@ -62,6 +62,35 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
   CHECK(test::children_of(up.pid()).empty());
 }
 
+TEST_CASE("cellctl up ends and restarts a process that runs but is not heard (a hung one), and the cell goes on",
+          "[process][cell]") {
+  const fs::path dir = test::scratch("unheard");
+  const std::string domain = "230";
+  const fs::path log = dir / "up.log";
+  // --wait: how long a process may go unheard, here 5 s after its 5 s liveliness lease.
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--wait", "5", "--state-dir", (dir / "state").string()},
+                        log.string());
+  REQUIRE(test::appears(log, "cell up on domain"));
+
+  // buffer-2 hangs: it runs, and says nothing on DDS.
+  const pid_t hung = test::child_with_argument(up.pid(), "buffer-2");
+  REQUIRE(hung > 0);
+  ::kill(hung, SIGSTOP);
+  REQUIRE(test::appears(log, "buffer-2 runs but has not been heard on DDS for", 60s));
+  REQUIRE(test::appears(log, "buffer-2 restarted", 30s));
+  CHECK_FALSE(test::is_running(hung));
+  const int order = test::cellctl({"submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
+                                   domain, "--order", "after-hang", "--out", (dir / "after-hang").string()},
+                                  dir / "order.log");
+  INFO(test::read_text(dir / "order.log") << test::read_text(log));
+  CHECK(order == 0);
+  bool journaled = false;
+  for (const auto& e : state::CellStore(dir / "state").journal_since(0)) journaled |= e.event == "unheard" && e.source == "buffer-2";
+  CHECK(journaled);
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
+  CHECK(up.wait_for_exit(30s) == 0);
+}
+
 TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, down says so and up starts afresh",
           "[process][cell]") {
   const fs::path dir = test::scratch("up-killed");
