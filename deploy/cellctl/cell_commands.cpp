@@ -319,6 +319,7 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
     if (s.order_id().to_string() == id) print_progress(s);
   });
   auto cell_seen = std::chrono::steady_clock::now();
+  std::string last_place;
   for (;;) {
     if (!running_state_dir(cell.domain).empty()) cell_seen = std::chrono::steady_clock::now();
     if (std::chrono::steady_clock::now() - cell_seen > 60s) {  // a paused cell that does not come back
@@ -328,7 +329,14 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
                 << "), and the next `cellctl up` on it takes the order up\n";
       return 3;
     }
-    for (const auto& known : store.orders()) {
+    const auto orders = store.orders();
+    const auto queue = OrderDesk::queue(orders);
+    if (const auto q = std::find(queue.begin(), queue.end(), order.id); q != queue.end()) {
+      const std::string place = "place " + std::to_string(q - queue.begin() + 1) + " of " + std::to_string(queue.size());
+      if (place != last_place) std::cout << "[" << order.id << "] waits in the cell's queue, " << place << std::endl;
+      last_place = place;
+    }
+    for (const auto& known : orders) {
       if (known.order != order.id || !known.ended() || known.exit_code < 0) continue;
       observer.on_status({});
       if (known.state == "DONE") std::cout << "order " << order.id << " done: " << out << "/report.html, " << out << "/plan.json, " << out << "/animation.gltf\n";
@@ -538,8 +546,14 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
                 << "not use them again; the journal names each (event 'inspection'). Check them on their station by hand.\n";
     }
     const auto orders = observer.orders();
-    std::cout << "\n" << orders.size() << " orders\n";
+    std::size_t queued = 0;
+    for (const auto& o : report["orders"]) queued += o.contains("place");
+    std::cout << "\n" << orders.size() << " orders under way or ended" << (queued ? ", " + std::to_string(queued) + " queued" : "")
+              << "\n";
     for (const auto& [id, s] : orders) print_progress(s);
+    for (const auto& o : report["orders"]) {
+      if (o.contains("place")) std::cout << "[" << o["order"].get<std::string>() << "] QUEUED, place " << o["place"] << " of " << queued << '\n';
+    }
   });
 
   CLI::App* down = app.add_subcommand("down", "Stop the cell that `cellctl up` started");

@@ -48,12 +48,12 @@ struct RestartPolicy {
   std::chrono::milliseconds max_backoff{8000};
 };
 
-// `desk: {max_order_mb: 64, orders_per_minute: 6, max_orders: 4}`: what the order desk takes
+// `desk: {max_order_mb: 64, orders_per_minute: 60, max_orders: 1000}`: what the order desk takes
 // from remote clients (docs/order-desk.md); past a limit it refuses with the reason.
 struct DeskLimits {
   double max_order_mb = 64;   // the product's files, all together
   int orders_per_minute = 6;  // per client
-  int max_orders = 4;         // orders under way in the cell (twins), from any client
+  int max_orders = 1000;      // orders accepted and not ended (queued or under way), from any client
 };
 
 struct CellConfig {
@@ -105,6 +105,9 @@ struct CellConfig {
   // `standby_twins:` twins cellctl up starts before orders come, so that an order's twin has
   // joined the cell already (deploy/cellctl/twin_pool.hpp); 0: each twin starts with its order.
   int standby_twins = 1;
+  // `max_twins:` the twins cellctl up's desk runs at once for orders (standby ones apart); the
+  // other orders wait in the cell's queue, in the order they came (docs/order-desk.md).
+  int max_twins = 16;
   // `twin_identities:` with security, the twins that may run at once, standby ones included:
   // each has a certificate of its own, twin-1 .. twin-N (deploy/cellctl/twin_identities.hpp).
   int twin_identities = 10;

@@ -1,9 +1,11 @@
 #include "deploy/cellctl/cell_status.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 #include <set>
 
+#include "deploy/cellctl/order_desk.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -44,8 +46,14 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer)
   std::set<std::string> listed;
   const auto live = observer.orders();
   if (store) {
-    for (const auto& o : store->orders()) {
-      orders.push_back({{"order", o.order}, {"state", o.state}, {"reason", o.reason}, {"quote", o.quote}});
+    const auto stored = store->orders();
+    const auto queue = OrderDesk::queue(stored);
+    for (const auto& o : stored) {
+      json order = {{"order", o.order}, {"state", o.state}, {"reason", o.reason}, {"quote", o.quote}};
+      if (const auto q = std::find(queue.begin(), queue.end(), o.order); q != queue.end()) {
+        order["place"] = q - queue.begin() + 1;  // in the cell's queue, 1 next
+      }
+      orders.push_back(order);
       listed.insert(o.order);
     }
   }

@@ -1,5 +1,6 @@
 #include "deploy/cellctl/order_desk.hpp"
 
+#include <algorithm>
 #include <vector>
 
 namespace cellctl {
@@ -29,16 +30,19 @@ void OrderDesk::tend() {
     identities_.give_back(it->second.identity);
     it = twins_.erase(it);
   }
-  // Read after the twins ended: what each wrote last is in.
-  std::map<std::string, state::OrderRecord> orders;
-  for (auto& o : store_.orders()) orders[o.order] = o;
+  // Read after the twins ended: what each wrote last is in. In the order they came.
+  const std::vector<state::OrderRecord> orders = store_.orders();
+  const auto record = [&orders](const std::string& id) -> const state::OrderRecord* {
+    const auto o = std::find_if(orders.begin(), orders.end(), [&id](const auto& r) { return r.order == id; });
+    return o == orders.end() ? nullptr : &*o;
+  };
 
   for (const auto& [id, code] : ended) {
-    const auto o = orders.find(id);
-    if (o == orders.end() || o->second.ended()) continue;
+    const state::OrderRecord* o = record(id);
+    if (!o || o->ended()) continue;
     // A twin the cell stopped (it went down, cell-sim restarted, a resource restarted under
     // its work) said INTERRUPTED: that is not the twin's failure. One that died says nothing.
-    const bool interrupted = o->second.state == "INTERRUPTED";
+    const bool interrupted = o->state == "INTERRUPTED";
     if (!interrupted) ++deaths_[id];
     log_("the twin of order " + id + " ended (exit " + std::to_string(code) + (interrupted ? ", interrupted" : "") +
          ") before its order did; starting it again in 1 s");
@@ -46,8 +50,22 @@ void OrderDesk::tend() {
     not_before_[id] = now + std::chrono::seconds(1);
   }
 
-  for (const auto& [id, o] : orders) {
+  int under_way = static_cast<int>(std::count_if(orders.begin(), orders.end(), [](const state::OrderRecord& o) {
+    return !o.ended() && !o.product.empty() && o.attempts > 0;
+  }));
+  int place = 0;
+  for (const state::OrderRecord& o : orders) {
+    const std::string& id = o.order;
     if (o.ended() || twins_.count(id) || o.product.empty()) continue;  // no product: not the desk's order
+    if (o.attempts == 0 && under_way >= cell_.max_twins) {
+      ++place;
+      if (o.state != "QUEUED") {
+        store_.set_order(id, "QUEUED");
+        store_.journal("cellctl", "queued", id, "place " + std::to_string(place) + ", behind " + std::to_string(under_way) +
+                                                    " orders under way (max_twins " + std::to_string(cell_.max_twins) + ")");
+      }
+      continue;
+    }
     if (const auto wait = not_before_.find(id); wait != not_before_.end() && now < wait->second) continue;
     std::string why;
     if (deaths_[id] >= max_deaths_) {
@@ -84,12 +102,21 @@ void OrderDesk::tend() {
                                   (was_standing_by ? ", standing by" : "") +
                                   (twin.identity.empty() ? "" : ", identity " + twin.identity);
       twins_[id] = std::move(twin);  // before anything else can throw: its identity comes back when it ends
+      if (attempt == 1) ++under_way;
       store_.journal("cellctl", "twin started", id, started);
       if (attempt > 1) log_("order " + id + ": twin started again (attempt " + std::to_string(attempt) + ")");
     } catch (const std::exception& e) {
       store_.set_order(id, "FAILED", std::string("its twin cannot be started: ") + e.what(), 1);
     }
   }
+}
+
+std::vector<std::string> OrderDesk::queue(const std::vector<state::OrderRecord>& orders) {
+  std::vector<std::string> out;
+  for (const auto& o : orders) {
+    if (o.state == "QUEUED") out.push_back(o.order);
+  }
+  return out;
 }
 
 void OrderDesk::interrupt_all() {

@@ -10,12 +10,18 @@
 // An order's twin is a standby one where one stands by (twin_pool.hpp); the journal's
 // "twin started" says its pid. With security each twin has an identity of its own, bound to
 // its order (twin_identities.hpp); an order waits while every identity runs a twin.
+//
+// At most `max_twins` orders are under way at once; the others wait in the cell's queue
+// (state QUEUED, journal "queued"), in the order they came, and start as those ahead end. An
+// order under way keeps its place while its twin is started again: no queued order takes
+// the twin of one that holds a station.
 
 #include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/processes.hpp"
@@ -37,6 +43,8 @@ class OrderDesk {
   // Stops every twin (each records its order INTERRUPTED); tend() starts them again.
   void interrupt_all();
   std::size_t running() const { return twins_.size(); }
+  // The orders waiting in the queue, first to start first.
+  static std::vector<std::string> queue(const std::vector<state::OrderRecord>& orders);
 
  private:
   const CellConfig& cell_;

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <optional>
 
+#include "deploy/cellctl/order_desk.hpp"
 #include "twin/description/automationml/automationml_description.hpp"
 #include "twin/description/product_description.hpp"
 #include "twin/model/source_ref.hpp"
@@ -114,7 +115,7 @@ RemoteDesk::RemoteDesk(const CellConfig& cell, state::CellStore& store, CellObse
     const fs::path folder = out.parent_path();
     if (known.ended() || out.filename() != "out" || folder.parent_path().parent_path() != cell.state_folder() / "desk") continue;
     const std::string client = folder.parent_path().filename(), submission = folder.filename();
-    if (clients_.count(client)) accepted_.push_back({client, submission, "", known.order, ""});
+    if (clients_.count(client)) accepted_.push_back({client, submission, known.request, known.order, ""});
   }
 }
 
@@ -180,7 +181,8 @@ void RemoteDesk::take_order(Client& client, const cell::OrderRequest& request) {
   const auto orders = store_.orders();
   const auto under_way = std::count_if(orders.begin(), orders.end(), [](const auto& o) { return !o.ended(); });
   if (under_way >= cell_.desk.max_orders) {
-    return refuse(client, request, "the cell has " + std::to_string(under_way) + " orders under way, its limit; try again later", 1);
+    return refuse(client, request, "the cell has " + std::to_string(under_way) +
+                                       " orders queued or under way, its limit (desk: max_orders); try again later", 1);
   }
   if (std::any_of(orders.begin(), orders.end(), [&](const auto& o) { return o.order == order; })) {
     return refuse(client, request, "the cell has an order " + order + " already: give this one another submission id", 2);
@@ -231,6 +233,8 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
     fs::create_directories(folder / "out");
     state::OrderRecord record{order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"};
     record.quote = request.quote();
+    record.client = client.id;
+    record.request = request.request().to_string();
     if (!store_.submit_order(record)) {
       fs::remove_all(folder, ignored);
       return refuse(client, request, "the cell has an order " + order + " already", 2);
@@ -246,9 +250,15 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
   accepted_.push_back({client.id, submission, request.request().to_string(), order, ""});
 }
 
-void RemoteDesk::follow(Accepted& a, const std::map<std::string, cell::OrderStatus>& statuses) {
+void RemoteDesk::follow(Accepted& a, const std::map<std::string, cell::OrderStatus>& statuses,
+                        const std::vector<std::string>& queue) {
   Client& client = *clients_.at(a.client);
-  if (const auto s = statuses.find(a.order); s != statuses.end()) {
+  if (const auto q = std::find(queue.begin(), queue.end(), a.order); q != queue.end()) {
+    const std::string now = "waits in the cell's queue, place " + std::to_string(q - queue.begin() + 1) + " of " +
+                            std::to_string(queue.size());
+    if (now != a.last_state) reply(client, a.submission, a.request, a.order, cell::DESK_PROGRESS, now);
+    a.last_state = now;
+  } else if (const auto s = statuses.find(a.order); s != statuses.end()) {
     const std::string now = std::to_string(static_cast<int>(s->second.state())) + "|" + s->second.message().to_string();
     if (now != a.last_state) {
       a.last_state = now;
@@ -299,8 +309,9 @@ void RemoteDesk::tend() {
     // The database and the statuses once a round, and only while a client's order is open.
     const auto orders = accepted_.empty() ? std::vector<state::OrderRecord>{} : store_.orders();
     const auto statuses = accepted_.empty() ? std::map<std::string, cell::OrderStatus>{} : observer_.orders();
+    const auto queue = OrderDesk::queue(orders);
     for (auto it = accepted_.begin(); it != accepted_.end();) {
-      follow(*it, statuses);
+      follow(*it, statuses, queue);
       const auto known = std::find_if(orders.begin(), orders.end(), [&](const auto& o) { return o.order == it->order; });
       if (known == orders.end() || !known->ended() || known->exit_code < 0) {
         ++it;

@@ -51,7 +51,8 @@ class RemoteDesk {
   void reply(Client& client, const std::string& submission, const std::string& request, const std::string& order,
              cell::DeskState state, const std::string& message, double progress = 0, unsigned result_files = 0,
              int exit_code = 0);
-  void follow(Accepted& order, const std::map<std::string, cell::OrderStatus>& statuses);  // relays its progress
+  // Relays its place in the cell's queue, then its progress.
+  void follow(Accepted& order, const std::map<std::string, cell::OrderStatus>& statuses, const std::vector<std::string>& queue);
   void finish(Accepted& order, const state::OrderRecord& record);  // the last reply and the results
 
   const CellConfig& cell_;

@@ -33,7 +33,7 @@ CREATE TABLE IF NOT EXISTS orders(
   order_id TEXT PRIMARY KEY, state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '', updated REAL,
   product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', sequence TEXT NOT NULL DEFAULT '',
   path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0,
-  quote INTEGER NOT NULL DEFAULT 0);
+  quote INTEGER NOT NULL DEFAULT 0, client TEXT NOT NULL DEFAULT '', request TEXT NOT NULL DEFAULT '');
 CREATE TABLE IF NOT EXISTS plan_steps(
   order_id TEXT NOT NULL, position INTEGER NOT NULL, step TEXT NOT NULL, trajectory TEXT NOT NULL,
   PRIMARY KEY(order_id, position));
@@ -181,6 +181,10 @@ void CellStore::add_columns_of_later_versions() {
     return c.step();
   };
   if (!has("orders", "quote")) exec("ALTER TABLE orders ADD COLUMN quote INTEGER NOT NULL DEFAULT 0");
+  if (!has("orders", "client")) {
+    exec("ALTER TABLE orders ADD COLUMN client TEXT NOT NULL DEFAULT ''; "
+         "ALTER TABLE orders ADD COLUMN request TEXT NOT NULL DEFAULT ''");
+  }
   if (!has("parts", "from_kept")) {
     // A give under way when the cell was upgraded is undone as before: kept for its order again.
     exec("ALTER TABLE parts ADD COLUMN from_kept INTEGER NOT NULL DEFAULT 0; "
@@ -488,9 +492,9 @@ std::map<std::string, std::string> CellStore::holders() const {
 }
 
 bool CellStore::submit_order(const OrderRecord& o) {
-  Statement(db_, "INSERT OR IGNORE INTO orders(order_id, state, updated, product, out_dir, sequence, path_planner, quote) "
-                 "VALUES(?, 'SUBMITTED', ?, ?, ?, ?, ?, ?)")
-      .bind(o.order, unix_now(), o.product, o.out, o.sequence, o.path, o.quote ? 1 : 0)
+  Statement(db_, "INSERT OR IGNORE INTO orders(order_id, state, updated, product, out_dir, sequence, path_planner, quote, "
+                 "client, request) VALUES(?, 'SUBMITTED', ?, ?, ?, ?, ?, ?, ?, ?)")
+      .bind(o.order, unix_now(), o.product, o.out, o.sequence, o.path, o.quote ? 1 : 0, o.client, o.request)
       .step();
   return sqlite3_changes(db_) == 1;
 }
@@ -515,11 +519,12 @@ int CellStore::count_attempt(const std::string& order) {
 
 std::vector<OrderRecord> CellStore::orders() const {
   Statement rows(db_, "SELECT order_id, state, reason, product, out_dir, sequence, path_planner, IFNULL(exit_code, -1), "
-                      "attempts, quote FROM orders ORDER BY order_id");
+                      "attempts, quote, client, request, rowid FROM orders ORDER BY rowid");
   std::vector<OrderRecord> out;
   while (rows.step()) {
     out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(4), rows.text(5), rows.text(6),
-                   static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8)), rows.integer(9) != 0});
+                   static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8)), rows.integer(9) != 0,
+                   rows.text(10), rows.text(11), rows.integer(12)});
   }
   return out;
 }

@@ -65,6 +65,10 @@ struct OrderRecord {
   int exit_code = -1;
   int attempts = 0;
   bool quote = false;  // an order for a quote: virtual assembly only (docs/quotes.md)
+  // A remote client's order: the client and its request's id (the desk answers it again
+  // after a restart of cellctl up); "" for a local one.
+  std::string client{}, request{};
+  long arrival = 0;    // the order's place in the cell's arrival order (its row; set by the store)
   bool ended() const;  // DONE or FAILED
 };
 
@@ -157,7 +161,7 @@ class CellStore {
   void set_order(const std::string& order, const std::string& state, const std::string& reason = "", int exit_code = -1);
   // One more twin started for the order; the attempts so far.
   int count_attempt(const std::string& order);
-  std::vector<OrderRecord> orders() const;
+  std::vector<OrderRecord> orders() const;  // in the order they came
   // Stored when physical assembly begins, so that a twin taking the order up follows it.
   void set_plan(const std::string& order, const std::vector<PlanStepRecord>& steps);
   std::vector<PlanStepRecord> plan_of(const std::string& order) const;

@@ -413,11 +413,11 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   const fs::path dir = test::scratch("order-desk");
   const std::string domain = "226";
   // The default cell, with a desk that takes 50 kB (the Lego tower, not Cranfield), one
-  // order a minute per client and one order under way in the cell.
+  // order a minute per client and one order queued or under way in the cell.
   std::string yaml = test::read_text(DEFAULT_CELL);
   yaml.replace(yaml.find("max_order_mb: 64"), 16, "max_order_mb: 0.05");
-  yaml.replace(yaml.find("orders_per_minute: 6"), 20, "orders_per_minute: 1");
-  yaml.replace(yaml.find("max_orders: 4"), 13, "max_orders: 1");
+  yaml.replace(yaml.find("orders_per_minute: 60"), 21, "orders_per_minute: 1");
+  yaml.replace(yaml.find("max_orders: 1000"), 16, "max_orders: 1");
   yaml.replace(yaml.find("clients: [oem-a, oem-b]"), 23, "clients: [oem-a, oem-b, oem-c, oem-d, oem-e]");
   const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
   std::ofstream(cell) << yaml;
@@ -504,7 +504,7 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   // An order under way in the cell (one its desk did not take: no twin of the desk runs it)
   // makes the cell full at one: oem-e's order is refused with the reason, and the desk stays.
   state::CellStore(dir / "state").set_order("placed-elsewhere", "PHYSICAL_ASSEMBLY");
-  CHECK(refused("busy", submit("oem-e", kLego, "busy"), "the cell has 1 orders under way, its limit; try again later") == 1);
+  CHECK(refused("busy", submit("oem-e", kLego, "busy"), "the cell has 1 orders queued or under way, its limit (desk: max_orders); try again later") == 1);
   CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-e" / "busy"));
 
   // oem-b's certificate reads its own answers, not oem-a's, nor the cell's order status.

@@ -54,3 +54,19 @@ TEST_CASE("deployment: discovery is simple by default, through servers where the
   CHECK_THROWS_WITH(cell_with("discovery: server\nsecurity: pki\n"),
                     Catch::Contains("discovery through a server does not work with security"));
 }
+
+TEST_CASE("deployment: max_twins bounds the orders under way (16 by default), the desk takes 1000 not ended, and each process names its resources", "[cellctl][config]") {
+  const auto plain = cell_with("");
+  CHECK(plain.max_twins == 16);
+  CHECK(plain.desk.max_orders == 1000);
+  CHECK(cell_with("max_twins: 2\n").max_twins == 2);
+  CHECK_THROWS_WITH(cell_with("max_twins: 0\n"), Catch::Contains(":2: max_twins must be 1..256"));
+  CHECK_THROWS_WITH(cell_with("max_twins: many\n"), Catch::Contains(":2"));
+  // What cellctl up's watchdog listens for in each process.
+  const auto processes = cellctl::cell_processes(plain, "/bin");
+  const auto station = std::find_if(processes.begin(), processes.end(), [](const auto& p) { return p.name == "station-1"; });
+  REQUIRE(station != processes.end());
+  CHECK(station->resources == std::vector<std::string>{"station-1", "arm-1"});
+  CHECK(processes.front().name == "cell-sim");
+  CHECK(processes.front().resources.empty());
+}

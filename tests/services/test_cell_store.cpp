@@ -271,10 +271,28 @@ TEST_CASE("a database of an earlier version gets the later columns and is used a
   REQUIRE(sqlite3_open(state::CellStore::file_in(dir).c_str(), &db) == SQLITE_OK);
   int columns = 0;
   REQUIRE(sqlite3_exec(db, "SELECT name FROM pragma_table_info('parts') WHERE name = 'from_kept' UNION ALL "
-                           "SELECT name FROM pragma_table_info('orders') WHERE name = 'quote'",
+                           "SELECT name FROM pragma_table_info('orders') WHERE name IN ('quote', 'client', 'request')",
                        [](void* n, int, char**, char**) { return ++*static_cast<int*>(n), 0; }, &columns, nullptr) == SQLITE_OK);
   sqlite3_close(db);
-  CHECK(columns == 2);
+  CHECK(columns == 4);
+}
+
+TEST_CASE("orders come back in the order they came, with a remote order's client and request", "[state]") {
+  state::CellStore store(fresh_dir("arrival"));
+  for (const char* id : {"zeta", "alpha", "mid"}) REQUIRE(store.submit_order({id, "", "", "p.aml", "out", "search", "linear"}));
+  state::OrderRecord remote{"oem-a-x", "", "", "p.aml", "out", "search", "linear"};
+  remote.client = "oem-a";
+  remote.request = "r-17";
+  REQUIRE(store.submit_order(remote));
+  store.set_order("alpha", "QUEUED");  // a change keeps its place
+  std::vector<std::string> ids;
+  for (const auto& o : store.orders()) ids.push_back(o.order);
+  CHECK(ids == std::vector<std::string>{"zeta", "alpha", "mid", "oem-a-x"});
+  const auto orders = store.orders();
+  CHECK(orders[0].arrival < orders[1].arrival);
+  CHECK(orders[3].client == "oem-a");
+  CHECK(orders[3].request == "r-17");
+  CHECK(orders[0].client.empty());
 }
 
 TEST_CASE("bookings, orders and the journal", "[state]") {

@@ -1,0 +1,118 @@
+// The desk's queue: past max_twins, orders wait in the cell's state in the order they came,
+// each says its place, and a cellctl up killed mid-way loses none of them.
+
+#include <algorithm>
+#include <map>
+#include <memory>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include "services/state/cell_store.hpp"
+#include "tests/support/cell_test.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+// Waits until the journal has the event for the order.
+bool journaled(const fs::path& state, const std::string& event, const std::string& order, std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fs::exists(state::CellStore::file_in(state))) {
+      for (const auto& e : state::CellStore(state).journal_since(0)) {
+        if (e.event == event && e.order == order) return true;
+      }
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("order queue: past max_twins orders wait in the order they came and say their places, and a killed up loses none",
+          "[process][cell][desk]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("order-queue"), state = dir / "state";
+  const std::string domain = "231";
+  std::string yaml = test::read_text(DEFAULT_CELL);
+  yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: 2");
+  const fs::path cell = dir / "cell.yaml";
+  std::ofstream(cell) << yaml;
+  const auto up_argv = [&] {
+    return std::vector<std::string>{CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "50",
+                                    "--state-dir", state.string()};
+  };
+  auto up = std::make_unique<test::ChildProcess>(up_argv(), (dir / "up-1.log").string());
+  REQUIRE(test::appears(dir / "up-1.log", "cell up on domain", 60s));
+
+  // Five Lego towers, one after another (each stored before the next is sent).
+  const std::vector<std::string> ids = {"q1", "q2", "q3", "q4", "q5"};
+  std::vector<std::unique_ptr<test::ChildProcess>> submits;
+  for (const auto& id : ids) {
+    submits.push_back(std::make_unique<test::ChildProcess>(
+        std::vector<std::string>{CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--cell",
+                                 cell.string(), "--domain", domain, "--order", id, "--out", (dir / id).string()},
+        (dir / (id + ".log")).string()));
+    REQUIRE(journaled(state, "submitted", id, 30s));
+  }
+
+  // What the operator sees while orders wait: each queued one with its place, in arrival order.
+  REQUIRE(journaled(state, "queued", "q5", 30s));
+  REQUIRE(test::cellctl({"status", "--cell", cell.string(), "--domain", domain, "--json"}, dir / "status.json", 60s) == 0);
+  const auto status = nlohmann::json::parse(test::read_text(dir / "status.json"));
+  std::vector<std::pair<int, std::string>> places;
+  for (const auto& o : status["orders"]) {
+    if (o.contains("place")) places.emplace_back(o["place"].get<int>(), o["order"].get<std::string>());
+  }
+  INFO(status.dump(1));
+  REQUIRE_FALSE(places.empty());
+  std::sort(places.begin(), places.end());
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    CHECK(places[i].first == static_cast<int>(i) + 1);
+    if (i > 0) CHECK(places[i - 1].second < places[i].second);  // q1 < q2 < ...: the order they came in
+  }
+  CHECK(places.back().second == "q5");
+
+  // cellctl up dies hard while orders run and wait; the next up takes every one up.
+  REQUIRE(journaled(state, "twin started", "q3", 120s));
+  const auto children = test::children_of(up->pid());
+  up->kill_hard();
+  for (const auto& [name, pid] : children) {
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (test::is_running(pid) && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(50ms);
+  }
+  up = std::make_unique<test::ChildProcess>(up_argv(), (dir / "up-2.log").string());
+  REQUIRE(test::appears(dir / "up-2.log", "cell up on domain", 60s));
+
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const int code = submits[i]->wait_for_exit(180s);
+    INFO(ids[i] << ":\n" << test::read_text(dir / (ids[i] + ".log")) << test::error_lines(test::read_text(dir / "up-2.log")));
+    CHECK(code == 0);
+  }
+  CHECK(test::read_text(dir / "q5.log").find("waits in the cell's queue, place") != std::string::npos);
+
+  // From the journal: each order's first twin started in arrival order, and never more than
+  // max_twins orders were under way at once (from their first twin to their end).
+  std::vector<std::string> first_started;
+  std::map<std::string, bool> under_way;
+  std::size_t most = 0;
+  for (const auto& e : state::CellStore(state).journal_since(0)) {
+    if (e.event == "twin started" && !under_way.count(e.order)) {
+      first_started.push_back(e.order);
+      under_way[e.order] = true;
+    }
+    if ((e.event == "DONE" || e.event == "FAILED") && under_way.count(e.order)) under_way[e.order] = false;
+    most = std::max<std::size_t>(most, std::count_if(under_way.begin(), under_way.end(), [](const auto& u) { return u.second; }));
+  }
+  CHECK(first_started == ids);
+  CHECK(most <= 2);
+  for (const auto& o : state::CellStore(state).orders()) {
+    INFO(o.order << ": " << o.state << " " << o.reason);
+    CHECK(o.state == "DONE");
+  }
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
+  CHECK(up->wait_for_exit(30s) == 0);
+}
