@@ -16,6 +16,7 @@
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
 #include "deploy/cellctl/cell_status.hpp"
+#include "deploy/cellctl/host_limits.hpp"
 #include "deploy/cellctl/order_desk.hpp"
 #include "deploy/cellctl/processes.hpp"
 #include "deploy/cellctl/remote_desk.hpp"
@@ -139,6 +140,16 @@ void wait_for_cell(const CellConfig& cell, CellObserver& observer, std::chrono::
   for (const auto& m : missing) list += " " + m;
   throw std::runtime_error("the cell did not come up within " + std::to_string(std::max(wait, waited).count() / 1000) +
                            " s; missing:" + list);
+}
+
+// Throws ConfigError naming each limit of this host that the cell with `twins` twins at once
+// would pass (host_limits.hpp); `what`: where those twins come from.
+void check_host_limits(const CellConfig& cell, std::size_t twins, const std::string& what) {
+  const auto problems = limit_problems(cell, cell_processes(cell, executable_dir()).size(), twins, read_host_limits());
+  if (problems.empty()) return;
+  std::string text = cell.file.string() + ": the cell with " + std::to_string(twins) + " " + what + " does not fit this host";
+  for (const auto& p : problems) text += "\n  " + p;
+  throw ConfigError(text);
 }
 
 // The resources alive on DDS now.
@@ -387,6 +398,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   up->callback([cell_options, &exit_code] {
     const CellConfig cell = cell_options->load();
     cell.check_twin_identities();
+    check_host_limits(cell, static_cast<std::size_t>(cell.max_twins), "max_twins");
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
     bool stale = false;
@@ -604,6 +616,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       cell.simple_discovery = false;
       std::cout << participants << " participants, more than simple discovery takes: through a discovery server" << std::endl;
     }
+    check_host_limits(cell, orders.size(), "orders at once (cellctl up's queue runs max_twins of them at once)");
     CellObserver observer(cell.participant_settings("cellctl"));
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/host_limits.hpp"
 #include "tests/support/scratch.hpp"
 
 namespace {
@@ -69,4 +70,37 @@ TEST_CASE("deployment: max_twins bounds the orders under way (16 by default), th
   CHECK(station->resources == std::vector<std::string>{"station-1", "arm-1"});
   CHECK(processes.front().name == "cell-sim");
   CHECK(processes.front().resources.empty());
+}
+
+TEST_CASE("host limits: participants for simple discovery and for Fast DDS's ports, memory, threads, open files", "[cellctl][config]") {
+  const cellctl::HostLimits roomy{24000, 100000, 1024};
+  const auto cell = cell_with("");  // 5 processes: cell-sim, a station, a robot, two buffers
+  CHECK(cellctl::limit_problems(cell, 5, 16, roomy).empty());  // 5 + 16 + 1 standing by + cellctl = 23
+  const auto crowded = cellctl::limit_problems(cell, 5, 22, roomy);
+  REQUIRE(crowded.size() == 1);
+  CHECK_THAT(crowded[0], Catch::Contains("29 DDS participants on this host") && Catch::Contains("discovery: server"));
+
+  const auto server = cell_with("discovery: server\n");
+  CHECK(cellctl::limit_problems(server, 6, 100, roomy).empty());
+  CHECK_THAT(cellctl::limit_problems(server, 6, 110, roomy).at(0), Catch::Contains("pass the 116 Fast DDS gives ports to"));
+  // The ports of the highest domain run out sooner: 7400 + 250 x 232 + 10 + 2 x id + 1 <= 65535.
+  CHECK(cellctl::participant_ports(0) == 120);
+  CHECK(cellctl::participant_ports(230) == 120);
+  CHECK(cellctl::participant_ports(232) == 63);
+
+  const auto small = cellctl::limit_problems(server, 6, 60, {2048, 100000, 1024});
+  REQUIRE(small.size() == 1);
+  CHECK_THAT(small[0], Catch::Contains("the host has 2048 MB: lower max_twins"));
+  CHECK_THAT(cellctl::limit_problems(server, 6, 60, {24000, 500, 1024}).at(0), Catch::Contains("(ulimit -u)"));
+  CHECK_THAT(cellctl::limit_problems(server, 6, 60, {24000, 100000, 128}).at(0), Catch::Contains("(ulimit -n)"));
+}
+
+TEST_CASE("every shipped cell fits a host of 2 cores and 8 GB with its max_twins", "[cellctl][config]") {
+  for (const auto& entry : std::filesystem::directory_iterator(DEPLOY_CELLS)) {
+    if (entry.path().extension() != ".yaml") continue;
+    INFO(entry.path());
+    const auto cell = cellctl::read_cell_config(entry.path());
+    const auto processes = cellctl::cell_processes(cell, "/bin").size();
+    CHECK(cellctl::limit_problems(cell, processes, static_cast<std::size_t>(cell.max_twins), {8192, 4096, 1024}).empty());
+  }
 }
