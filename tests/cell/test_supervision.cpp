@@ -130,3 +130,18 @@ TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, dow
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down2.log", 30s) == 0);
   CHECK(up->wait_for_exit(20s) == 0);
 }
+
+TEST_CASE("cellctl up refuses a cell that would pass a limit of the host, says which and what to change, and starts nothing",
+          "[process][cell]") {
+  const fs::path dir = test::scratch("too-many-twins");
+  std::string yaml = test::read_text(DEFAULT_CELL);
+  yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: 40");
+  const fs::path cell = dir / "cell.yaml";
+  std::ofstream(cell) << yaml;
+  CHECK(test::cellctl({"up", cell.string(), "--domain", "232", "--state-dir", (dir / "state").string()}, dir / "up.log", 30s) == 2);
+  const std::string log = test::read_text(dir / "up.log");
+  INFO(log);
+  CHECK(log.find("47 DDS participants on this host (5 processes, 40 twins at once, 1 standing by, cellctl) pass the 28 that "
+                 "simple discovery finds: set `discovery: server`, or lower max_twins") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "state"));
+}
