@@ -3,7 +3,6 @@
 //   buffer --id buffer-1 --domain 42 --stock SquarePeg=2 --stock RoundPeg=4
 
 #include <atomic>
-#include <csignal>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -11,12 +10,6 @@
 #include "services/buffer/buffer_service.hpp"
 #include "services/dds/cli_options.hpp"
 #include "services/node/run.hpp"
-
-namespace {
-// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
-std::atomic<bool> running{true};
-void stop(int) { running = false; }
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"buffer: a part buffer of the assembly cell"};
@@ -43,9 +36,7 @@ int main(int argc, char** argv) {
     std::cerr << "error: --stock: " << e.what() << '\n';
     return 2;
   }
-  std::signal(SIGINT, stop);
-  std::signal(SIGTERM, stop);
-  services::stop_with_parent();
+  const std::atomic<bool>& running = services::run_until_signalled();
   try {
     services::BufferService service(config);
     std::cout << "buffer " << config.node.id << " ready on domain " << config.dds.domain_id << std::endl;

@@ -5,7 +5,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <iostream>
 #include <thread>
 
@@ -13,11 +12,6 @@
 
 #include "services/dds/cli_options.hpp"
 #include "services/node/run.hpp"
-
-namespace {
-std::atomic<bool> running{true};
-void stop(int) { running = false; }
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"discovery-server: a DDS discovery server of the assembly cell"};
@@ -38,9 +32,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  std::signal(SIGINT, stop);
-  std::signal(SIGTERM, stop);
-  services::stop_with_parent();
+  const std::atomic<bool>& running = services::run_until_signalled();
   const std::string name = "discovery-" + std::to_string(settings.discovery.serve);
   if (settings.security.identity.empty()) settings.security.identity = "discovery";
   try {

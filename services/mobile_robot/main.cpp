@@ -4,7 +4,6 @@
 //   mobile-robot --domain 42 --id mobile-robot-1 --home 1.5 0 1.2 --speed 0.8
 
 #include <atomic>
-#include <csignal>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -17,12 +16,6 @@
 #include "services/mobile_robot/mobile_robot_block.hpp"
 #include "services/node/resource_node.hpp"
 #include "services/node/run.hpp"
-
-namespace {
-// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
-std::atomic<bool> running{true};
-void stop(int) { running = false; }
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"mobile-robot: fetches parts from buffers to the station"};
@@ -43,9 +36,7 @@ int main(int argc, char** argv) {
   dds::add_state_option(app, config.state_dir);
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(dds, all_interfaces);
-  std::signal(SIGINT, stop);
-  std::signal(SIGTERM, stop);
-  services::stop_with_parent();
+  const std::atomic<bool>& running = services::run_until_signalled();
   try {
     auto participant = dds::make_participant(config.id, dds);
     fb::Resource resource(config.id, 1024);

@@ -26,6 +26,24 @@ inline void stop_with_parent() {
   if (const char* parent = std::getenv(kStartedByVariable); parent && std::atol(parent) != ::getppid()) std::raise(SIGTERM);
 }
 
+namespace detail {
+// Set by a signal handler, read by the process's threads: a lock-free atomic is safe for both.
+inline std::atomic<bool> running{true};
+inline void stop_running(int) { running = false; }
+}  // namespace detail
+
+// The flag of run_until_signalled(), for a process's other functions.
+inline const std::atomic<bool>& running_flag() { return detail::running; }
+
+// The flag a cell process runs on: cleared by SIGINT or SIGTERM, and so when the process that
+// started it ends (stop_with_parent). Call once, after the command line is read.
+inline const std::atomic<bool>& run_until_signalled() {
+  std::signal(SIGINT, detail::stop_running);
+  std::signal(SIGTERM, detail::stop_running);
+  stop_with_parent();
+  return detail::running;
+}
+
 // Armed when it goes out of scope: ends the process with `code` if it still runs `limit`
 // later. Declared after a process's DDS entities, it is destroyed before them: their teardown
 // may not hang the process (a twin once never ended after its order was interrupted, its

@@ -4,7 +4,6 @@
 //   station --domain 42 --id station-1 --arm-id arm-1 --position 0 0 0 --dock 0.6 0 0
 
 #include <atomic>
-#include <csignal>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -14,12 +13,6 @@
 #include "services/node/run.hpp"
 #include "services/station/arm_block.hpp"
 #include "services/station/station_block.hpp"
-
-namespace {
-// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
-std::atomic<bool> running{true};
-void stop(int) { running = false; }
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"station: the assembly station and its robot arm"};
@@ -55,9 +48,7 @@ int main(int argc, char** argv) {
   arm.angular_speed = arm_settings.angular_speed;
   arm.liveliness_lease_s = station.liveliness_lease_s;
   arm.state_dir = station.state_dir;
-  std::signal(SIGINT, stop);
-  std::signal(SIGTERM, stop);
-  services::stop_with_parent();
+  const std::atomic<bool>& running = services::run_until_signalled();
   try {
     arm.bounds = station.bounds = dds::apply_bounds(bounds);
     auto participant = dds::make_participant(station.id, dds);

@@ -5,7 +5,6 @@
 //   cell-sim --domain 42 --real-time-factor 20
 
 #include <atomic>
-#include <csignal>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -20,12 +19,6 @@
 #include "simulationPubSubTypes.h"
 #include "services/node/run.hpp"
 #include "services/state/cell_store.hpp"
-
-namespace {
-// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
-std::atomic<bool> running{true};
-void stop(int) { running = false; }
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"cell-sim: the shared simulation of the assembly cell"};
@@ -42,9 +35,7 @@ int main(int argc, char** argv) {
   dds::add_state_option(app, state_dir);
   CLI11_PARSE(app, argc, argv);
   dds::apply_interfaces(settings, all_interfaces);
-  std::signal(SIGINT, stop);
-  std::signal(SIGTERM, stop);
-  services::stop_with_parent();
+  const std::atomic<bool>& running = services::run_until_signalled();
   try {
     auto participant = dds::make_participant("cell-sim", settings);
     fb::Resource resource("cell-sim", 1024);

@@ -13,7 +13,6 @@
 #include <cstdio>
 #include <atomic>
 #include <thread>
-#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -49,9 +48,7 @@
 
 namespace {
 
-// Set by a signal handler, read by the resources' threads: a lock-free atomic is safe for both.
-std::atomic<bool> running{true};
-void stop(int) { running = false; }
+const std::atomic<bool>& running = services::running_flag();
 
 using dds::TopicKind;
 
@@ -551,9 +548,7 @@ int main(int argc, char** argv) {
     std::cerr << "error: a twin with --security needs --identity (twin-1 .. twin-N: cellctl starts twins so)\n";
     return 2;
   }
-  std::signal(SIGINT, stop);
-  std::signal(SIGTERM, stop);
-  services::stop_with_parent();
+  services::run_until_signalled();
   if (standby && !o.order.empty()) {
     std::cerr << "error: a standby twin reads its order from standard input, not --order\n";
     return 2;
