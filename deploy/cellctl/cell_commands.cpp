@@ -15,6 +15,7 @@
 
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
+#include "deploy/cellctl/cell_roster.hpp"
 #include "deploy/cellctl/cell_status.hpp"
 #include "deploy/cellctl/host_limits.hpp"
 #include "deploy/cellctl/order_desk.hpp"
@@ -409,6 +410,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     if (stale) std::cerr << "cellctl up: the last cellctl up on this domain was killed; starting the cell afresh\n";
     CellObserver observer(cell.participant_settings("order-desk"));
+    const RosterWriter roster(observer.participant(), cell);
     state::CellStore store(cell.state_folder());
     store.journal("cellctl", "up", "", "domain " + std::to_string(cell.domain));
     bool world_lost = false;  // cell-sim restarts: the twins' virtual scenes went with it
@@ -618,6 +620,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     check_host_limits(cell, orders.size(), "orders at once (cellctl up's queue runs max_twins of them at once)");
     CellObserver observer(cell.participant_settings("cellctl"));
+    const RosterWriter roster(observer.participant(), cell);
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();
     // A twin per order stands by while the cell comes up, as `up`'s desk keeps them: an order

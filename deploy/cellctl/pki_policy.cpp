@@ -99,14 +99,14 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
                       Topics{"cell/orders/status", "cell/orders/result", "cell/negotiation/calls", "cell/negotiation/awards",
                              "cell/negotiation/releases", "cell/cancel_requests", "cell/sim/requests"} + commanded,
                       Topics{"cell/clock", "cell/capabilities", "cell/negotiation/proposals", "cell/negotiation/replies",
-                             "cell/command_events", "cell/sim/replies"} + kEveryone});
+                             "cell/command_events", "cell/sim/replies", "cell/roster"} + kEveryone});
   }
   const Topics observer = Topics{"cell/clock", "cell/capabilities", "cell/orders/status", "cell/orders/result",
                                  "cell/orders/twins", "cell/command_events"} + kEveryone;
   // Both start twins (cellctl run; cellctl up's desk) and bind them to their orders.
-  grants.push_back({"cellctl", "cellctl", {}, {"cell/orders/twins"}, observer});
+  grants.push_back({"cellctl", "cellctl", {}, {"cell/orders/twins", "cell/roster"}, observer});
   // cellctl up: it observes the cell and runs the order desk of every client.
-  Grant desk{"order-desk", "order-desk", {}, {"cell/orders/twins"}, observer};
+  Grant desk{"order-desk", "order-desk", {}, {"cell/orders/twins", "cell/roster"}, observer};
   for (const auto& c : cell.clients) {
     desk.publish = desk.publish + Topics{desk_topic("replies", c), desk_topic("results", c)};
     desk.subscribe = desk.subscribe + Topics{desk_topic("files", c), desk_topic("orders", c)};

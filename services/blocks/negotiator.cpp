@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace fb {
 
@@ -12,7 +13,8 @@ Negotiator::Negotiator(std::string name, std::string order_id, NegotiationSettin
       evaluator_(std::move(evaluator)) {
   declare_input("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_input("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
-  declare_input("CAPABILITY", {"resource_id", "operations"});
+  declare_input("CAPABILITY", {"resource_id", "kind", "operations"});
+  declare_input("ROSTER", {"resources"});
   declare_input("RESOURCE_GONE", {"resource_id"});
   declare_input("PROPOSAL", {"call_id", "resource_id", "available", "reason", "earliest_start", "duration", "bid_time"});
   declare_input("AWARD_REPLY", {"call_id", "resource_id", "confirmed", "reason", "ahead"});
@@ -28,12 +30,24 @@ void Negotiator::receive(const Event& e) {
   if (e.name == "TICK") return tick();
   if (e.name == "CAPABILITY") {
     const auto ops = split_names(get<std::string>(e.data, "operations"));
-    operations_[get<std::string>(e.data, "resource_id")] = {ops.begin(), ops.end()};
+    const std::string& resource = get<std::string>(e.data, "resource_id");
+    operations_[resource] = {ops.begin(), ops.end()};
+    kinds_[resource] = get_or<std::string>(e.data, "kind", "");
+    gone_.erase(resource);
+    return;
+  }
+  if (e.name == "ROSTER") {
+    roster_.clear();
+    std::istringstream lines(get<std::string>(e.data, "resources"));
+    for (std::string line; std::getline(lines, line);) {
+      const auto tab = line.find('\t');
+      if (tab != std::string::npos && tab > 0) roster_[line.substr(0, tab)] = line.substr(tab + 1);
+    }
     return;
   }
   if (e.name == "RESOURCE_GONE") {
     const std::string& resource = get<std::string>(e.data, "resource_id");
-    operations_.erase(resource);
+    if (operations_.erase(resource)) gone_.insert(resource);
     for (auto& [id, c] : calls_) {
       c.bids.erase(resource);
       c.late.erase(resource);
@@ -165,6 +179,17 @@ void Negotiator::unavailable(const std::string& id) {
     if (ops.count(operation) && !c.refusals.count(resource)) {
       why += (why.empty() ? "" : "; ") + resource + " offers " + operation + " but never answered";
     }
+  }
+  // The cell's resources this twin does not hear, of a kind that offers the operation (any
+  // kind, when it hears none that does): their capabilities never came, or went.
+  std::set<std::string> kinds;
+  for (const auto& [resource, ops] : operations_) {
+    if (ops.count(operation)) kinds.insert(kinds_[resource]);
+  }
+  for (const auto& [resource, kind] : roster_) {
+    if (operations_.count(resource) || !(kinds.empty() || kinds.count(kind))) continue;
+    why += (why.empty() ? "" : "; ") + resource + " (" + kind + ") of the cell " +
+           (gone_.count(resource) ? "has gone (its liveliness lease ran out)" : "has not been heard by this twin");
   }
   reason += why.empty() ? " (no resource with that operation answered)" : " (" + why + ")";
   calls_.erase(id);

@@ -11,15 +11,20 @@
 // awarded, so that an order can learn what the cell would offer without taking anything. A
 // call for quotes that every resource with the operation refused is UNAVAILABLE after
 // `quote_patience` (a resource discovered late may still bid), not after the whole `wait`.
+// An UNAVAILABLE reason names each resource that was not heard: one that offers the operation
+// and never answered, and one of the cell's roster of a kind that offers it whose capability
+// never came (or went): the twin does not blame the stock it heard for what it cannot see.
 //
 //   inputs                                          outputs
 //   CALL (call_id, operation, part_type, station,   CFP (the call, with order_id)
 //         sources, count, duration)                 AWARD (call_id, resource_id, order_id, lease)
 //   ASK (as CALL: a call for quotes)                QUOTED (call_id, resource_id, earliest_start, duration,
 //                                                           bid_time)
-//   CAPABILITY (resource_id, operations): who       AWARDED (call_id, resource_id, ahead,
-//     may answer                                             earliest_start, duration)
+//   CAPABILITY (resource_id, kind, operations):     AWARDED (call_id, resource_id, ahead,
+//     who may answer                                         earliest_start, duration)
 //   RESOURCE_GONE (resource_id)                     UNAVAILABLE (call_id, reason)
+//   ROSTER (resources: "id<TAB>kind" lines): the
+//     cell's resources, heard or not
 //   PROPOSAL (call_id, resource_id, available, reason, earliest_start, duration, bid_time)
 //   AWARD_REPLY (call_id, resource_id, confirmed, reason, ahead)
 //   TICK: windows and waits (wall time)
@@ -97,6 +102,9 @@ class Negotiator : public FunctionBlock {
   NegotiationSettings settings_;
   std::shared_ptr<const BidEvaluator> evaluator_;
   std::map<std::string, std::set<std::string>> operations_;  // alive resource -> its operations
+  std::map<std::string, std::string> kinds_;                 // heard resource -> its kind
+  std::map<std::string, std::string> roster_;                // the cell's resource -> its kind
+  std::set<std::string> gone_;                               // heard, then gone
   std::map<std::string, Call> calls_;
 };
 

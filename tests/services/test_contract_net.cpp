@@ -239,6 +239,36 @@ TEST_CASE("negotiator: a call nobody bids on is called again, then unavailable w
   CHECK(reason.find("robot-1") == std::string::npos);
 }
 
+TEST_CASE("negotiator: a resource of the cell's roster it never heard, or heard go, is named, not blamed on the stock it heard",
+          "[fb][negotiation]") {
+  // A twin of a busy cell heard rack-a and rack-b (no Brick2x2 free) but never rack-c, which
+  // holds 250 of them: the reason says so (issue #33: "nobody offered" blamed the stock).
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", quick());
+  f.send("ROSTER", {{"resources", std::string("rack-a\tbuffer\nrack-b\tbuffer\nrack-c\tbuffer\nrack-d\tbuffer\n"
+                                              "robot-1\tmobile-robot\nstation-1\tstation\nbroken line\n")}});
+  for (const char* rack : {"rack-a", "rack-b", "rack-d"}) {
+    f.send("CAPABILITY", {{"resource_id", std::string(rack)}, {"kind", std::string("buffer")}, {"operations", std::string("give")}});
+  }
+  f.send("CAPABILITY", {{"resource_id", std::string("robot-1")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
+  f.send("RESOURCE_GONE", {{"resource_id", std::string("rack-d")}});
+  f.send("CALL", cfp("o1", "give"));
+  for (const char* rack : {"rack-a", "rack-b"}) {
+    f.send("PROPOSAL", {{"call_id", std::string("o1/give")}, {"resource_id", std::string(rack)}, {"available", false},
+                        {"reason", std::string("0 free, not 5")}, {"earliest_start", 0.0}, {"duration", 0.0}});
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  const auto out = f.send("TICK");
+  REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
+  const std::string& reason = fb::get<std::string>(out[0].data, "reason");
+  INFO(reason);
+  CHECK(reason.find("rack-a: 0 free, not 5; rack-b: 0 free, not 5") != std::string::npos);
+  CHECK(reason.find("rack-c (buffer) of the cell has not been heard by this twin") != std::string::npos);
+  CHECK(reason.find("rack-d (buffer) of the cell has gone (its liveliness lease ran out)") != std::string::npos);
+  // Not of a kind that gives: not named.
+  CHECK(reason.find("station-1") == std::string::npos);
+  CHECK(reason.find("robot-1") == std::string::npos);
+}
+
 TEST_CASE("negotiator: a confirmation that comes after the reply timeout is taken, and the resource takes the call once",
           "[fb][negotiation]") {
   // A buffer slowed down (a loaded machine) confirms later than the twin waits: the twin

@@ -24,6 +24,7 @@
 #include <CLI/CLI.hpp>
 
 #include "capabilitiesPubSubTypes.h"
+#include "rosterPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "negotiationPubSubTypes.h"
 #include "ordersPubSubTypes.h"
@@ -330,6 +331,14 @@ class TwinProcess {
         [](const cell::Capability& c) { return dds::to_data(c); },
         {{"orchestrator", "CAPABILITY"}, {"negotiator", "CAPABILITY"}},
         {{"orchestrator", "RESOURCE_GONE"}, {"negotiator", "RESOURCE_GONE"}});
+    subscribe<cell::CellRoster, cell::CellRosterPubSubType>(
+        r, "roster", "cell/roster", TopicKind::state,
+        [](const cell::CellRoster& roster) {
+          std::string lines;
+          for (const auto& e : roster.resources()) lines += e.resource_id().to_string() + "\t" + e.kind().to_string() + "\n";
+          return fb::Data{{"resources", lines}};
+        },
+        {{"negotiator", "ROSTER"}});
     subscribe<cell::Proposal, cell::ProposalPubSubType>(
         r, "proposals", "cell/negotiation/proposals", TopicKind::events,
         [](const cell::Proposal& p) { return dds::to_data(p); }, {{"negotiator", "PROPOSAL"}});
