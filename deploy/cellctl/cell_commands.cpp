@@ -219,6 +219,7 @@ struct SubmitOptions {
   std::vector<std::string> products;
   std::string order, out, sequence = "search", path = "linear";
   bool remote = false;
+  bool detach = false;
   std::string client;
 };
 
@@ -314,8 +315,9 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
 // Hands the order to the desk of the cell `cellctl up` runs (its database), and follows it to
 // its end: the twin's exit code (0 assembled, 1 failed, 2 a bad product description; 3 when no
 // cell has run on the domain for a minute: the order waits in the state for the next up).
-int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& order, CellObserver& observer) {
-  state::CellStore store(cell.state_folder());
+// Stores the order for the desk of the cell `cellctl up` runs; false (and why, on stderr)
+// when the cell has an order of that id.
+bool hand_to_desk(state::CellStore& store, const SubmitOptions& o, const Order& order) {
   const std::string product = fs::absolute(order.product).string(), out = fs::absolute(order.out).string();
   if (!store.submit_order({order.id, "", "", product, out, o.sequence, o.path})) {
     for (const auto& known : store.orders()) {
@@ -324,9 +326,16 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
                   << "); give this one another id with --order\n";
       }
     }
-    return 1;
+    return false;
   }
   store.journal("cellctl", "submitted", order.id, product);
+  return true;
+}
+
+int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& order, CellObserver& observer) {
+  state::CellStore store(cell.state_folder());
+  if (!hand_to_desk(store, o, order)) return 1;
+  const std::string out = fs::absolute(order.out).string();
   observer.on_status([id = order.id](const cell::OrderStatus& s) {
     if (s.order_id().to_string() == id) print_progress(s);
   });
@@ -480,6 +489,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   submit_cmd->add_flag("--remote", submit_options->remote,
                        "Send the order to the cell's order desk over DDS, as --client (docs/order-desk.md)");
   submit_cmd->add_option("--client", submit_options->client, "The client's id (the cell's `clients:`; with --security its identity)");
+  submit_cmd->add_flag("--detach", submit_options->detach,
+                       "Hand the order to the cell of cellctl up and return at once (cellctl status follows it)");
   submit_cmd->callback([cell_options, submit_options, &exit_code] {
     CellConfig cell = cell_options->load();
     std::signal(SIGINT, request_stop);
@@ -493,11 +504,11 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       exit_code = submit_remote(s, stop_requested);
       return;
     }
-    CellObserver observer(cell.participant_settings("cellctl"));
     auto orders = orders_of(*submit_options);
     // Read once: an up that started after load() looked (its pid file is new) keeps its
     // state where it says, and that is where its desk reads orders.
-    if (const std::string running = running_state_dir(cell.domain); !running.empty()) {
+    const std::string running = running_state_dir(cell.domain);
+    if (!running.empty()) {
       if (cell_options->state_dir.empty()) {
         cell.state_dir = running;
       } else if (fs::weakly_canonical(cell.state_folder()) != fs::weakly_canonical(running)) {
@@ -506,6 +517,17 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
         exit_code = 2;
         return;
       }
+    }
+    if (submit_options->detach) {
+      if (running.empty()) throw ConfigError("--detach hands the order to the cell of cellctl up, and none runs on domain " +
+                                             std::to_string(cell.domain));
+      state::CellStore store(cell.state_folder());
+      exit_code = hand_to_desk(store, *submit_options, orders.front()) ? 0 : 1;
+      if (exit_code == 0) std::cout << "order " << orders.front().id << " handed to the cell; `cellctl status` follows it\n";
+      return;
+    }
+    CellObserver observer(cell.participant_settings("cellctl"));
+    if (!running.empty()) {
       exit_code = submit_to_desk(cell, *submit_options, orders.front(), observer);
       return;
     }

@@ -45,21 +45,31 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
     return std::vector<std::string>{CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
                                     "--state-dir", state.string()};
   };
-  // Four Lego towers wait in the cell's state before it comes up (as after a day's orders came
-  // in overnight); a fifth comes through cellctl submit once it is up. A factor of 10: each
-  // order holds the one station for seconds, so the fifth finds two under way, also under
-  // ThreadSanitizer.
+  // Three Lego towers wait in the cell's state before it comes up (as after a day's orders came
+  // in overnight); a fourth is handed over with --detach and a fifth followed by cellctl
+  // submit once it is up. A factor of 10: each order holds the one station for seconds, so
+  // the last ones find two under way, also under ThreadSanitizer.
   const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
   const std::vector<std::string> ids = {"q1", "q2", "q3", "q4", "q5"};
+  const auto detach = [&](const std::string& id) {
+    return test::cellctl({"submit", "--detach", product, "--cell", cell.string(), "--domain", domain, "--order", id, "--out",
+                          (dir / id).string()},
+                         dir / (id + ".log"), 30s);
+  };
+  CHECK(detach("q4") == 2);  // no cell yet to hand it to
+  CHECK(test::read_text(dir / "q4.log").find("--detach hands the order to the cell of cellctl up, and none runs on domain 231") !=
+        std::string::npos);
   {
     state::CellStore store(state);
-    for (std::size_t i = 0; i + 1 < ids.size(); ++i) {
+    for (std::size_t i = 0; i < 3; ++i) {
       REQUIRE(store.submit_order({ids[i], "", "", product, (dir / ids[i]).string(), "search", "linear"}));
       store.journal("cellctl", "submitted", ids[i], product);
     }
   }
   auto up = std::make_unique<test::ChildProcess>(up_argv(), (dir / "up-1.log").string());
   REQUIRE(test::appears(dir / "up-1.log", "cell up on domain", 60s));
+  REQUIRE(detach("q4") == 0);
+  CHECK(test::read_text(dir / "q4.log").find("order q4 handed to the cell") != std::string::npos);
   test::ChildProcess submit({CELLCTL_EXE, "submit", product, "--cell", cell.string(), "--domain", domain, "--order", "q5",
                              "--out", (dir / "q5").string()},
                             (dir / "q5.log").string());
