@@ -150,12 +150,13 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     record(d);
     const std::string& state = get<std::string>(d, "state");
     if (const auto fetch = fetch_of_.find(id); fetch != fetch_of_.end()) {
-      if (state == "succeeded") {
-        delivered_.insert(id);
-        if (action_running_ && actions_.front().kind == Action::await_delivery && awaited_id_ == id) action_done();
-      } else if (state == "aborted" || state == "rejected") {
-        fail("fetching " + product_.product.parts()[fetch->second].name + " failed: " + get<std::string>(d, "reason"));
+      if (state == "aborted" || state == "rejected") {
+        return fail("fetching " + product_.product.parts()[fetch->second].name + " failed: " + get<std::string>(d, "reason"));
       }
+      if (state == "succeeded") delivered_.insert(id);
+      if (!action_running_ || awaited_id_ != id) return;
+      const Action::Kind awaiting = actions_.front().kind;
+      if (awaiting == Action::send_heard || (awaiting == Action::await_delivery && state == "succeeded")) action_done();
       return;
     }
     if (!action_running_ || id != awaited_id_) return;
@@ -856,7 +857,7 @@ void OrderOrchestrator::plan_physical() {
     fetch["source_award"] = settings_.order_id + "/" + kGive + type;
     fetch_of_[get<std::string>(fetch, "command_id")] = step.part;
     fetches.push_back(get<std::string>(fetch, "command_id"));
-    actions_.push_back({Action::send_only, fetch});
+    actions_.push_back({Action::send_heard, fetch});
   }
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const PlanStep& step = plan_.steps[steps[k]];
@@ -913,10 +914,9 @@ void OrderOrchestrator::next_action() {
       case Action::command:
         awaited_id_ = get<std::string>(a.data, "command_id");
         return send_command(a.data);
-      case Action::send_only:
-        send_command(a.data);
-        actions_.pop_front();
-        continue;
+      case Action::send_heard:
+        awaited_id_ = get<std::string>(a.data, "command_id");
+        return send_command(a.data);
       case Action::await_delivery:
         awaited_id_ = get<std::string>(a.data, "command_id");
         if (delivered_.count(awaited_id_)) {
