@@ -11,7 +11,8 @@ cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh --tests
 
 jobs=$(nproc)
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELL_BUILD_TESTS=ON -DCELL_BUILD_BENCHMARKS=ON
+# Benchmarks are built where they are run (docs/performance.md), not in this job's time.
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELL_BUILD_TESTS=ON -DCELL_BUILD_BENCHMARKS=OFF
 cmake --build build/release -j "$jobs"
 # Shared-memory segments of DDS processes that died hard break discovery: clean them first.
 fastdds shm clean >/dev/null 2>&1 || true
@@ -23,9 +24,14 @@ cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_SANITIZE=O
   -DCMAKE_CXX_COMPILER=clang++ -DCELL_BUILD_BENCHMARKS=OFF
 cmake --build build/sanitize -j "$jobs"
 fastdds shm clean >/dev/null 2>&1 || true
+# The six longest process tests (many orders at once, chaos, security, the queue: 379 of the
+# 770 process-seconds of this phase's process tests) run in the Release and ThreadSanitizer phases; here
+# their code paths are covered by the shorter process tests, and the whole job stays well
+# under an hour on 2 cores (58 min with them, 2026-12-05).
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp \
-  ctest --test-dir build/sanitize --output-on-failure -j "$jobs"
+  ctest --test-dir build/sanitize --output-on-failure -j "$jobs" \
+  -E "^(chaos|secure cell|order desk|order queue|many orders):"
 
 cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_TSAN=ON -DCMAKE_CXX_COMPILER=clang++ \
   -DCELL_BUILD_BENCHMARKS=OFF
