@@ -131,16 +131,16 @@ CellConfig CellOptions::load() const {
   return c;
 }
 
-// Until every resource of the file has published its capability; throws naming the missing
-// (`waited`: how long the caller waited in all, when more than `wait`).
-void wait_for_cell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait,
-                   std::chrono::milliseconds waited = 0ms) {
-  const auto missing = observer.wait_for_resources(cell.resource_ids(), wait);
-  if (missing.empty()) return;
+[[noreturn]] void cell_did_not_come_up(const std::vector<std::string>& missing, std::chrono::milliseconds waited) {
   std::string list;
   for (const auto& m : missing) list += " " + m;
-  throw std::runtime_error("the cell did not come up within " + std::to_string(std::max(wait, waited).count() / 1000) +
-                           " s; missing:" + list);
+  throw std::runtime_error("the cell did not come up within " + std::to_string(waited.count() / 1000) + " s; missing:" + list);
+}
+
+// Until every resource of the file has published its capability; throws naming the missing.
+void wait_for_cell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait) {
+  const auto missing = observer.wait_for_resources(cell.resource_ids(), wait);
+  if (!missing.empty()) cell_did_not_come_up(missing, wait);
 }
 
 // Throws ConfigError naming each limit of this host that the cell with `twins` twins at once
@@ -351,9 +351,7 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
       return 3;
     }
     const auto orders = store.orders();
-    const auto queue = OrderDesk::queue(orders);
-    if (const auto q = std::find(queue.begin(), queue.end(), order.id); q != queue.end()) {
-      const std::string place = "place " + std::to_string(q - queue.begin() + 1) + " of " + std::to_string(queue.size());
+    if (const std::string place = OrderDesk::place_text(OrderDesk::queue(orders), order.id); !place.empty()) {
       if (place != last_place) std::cout << "[" << order.id << "] waits in the cell's queue, " << place << std::endl;
       last_place = place;
     }
@@ -447,7 +445,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
         }
         if (const std::string why = supervisor.tend(); !why.empty()) throw std::runtime_error(why);
         const bool others_missing = std::any_of(missing.begin(), missing.end(), [&](const std::string& r) { return !supervisor.runs(r); });
-        if (others_missing && std::chrono::steady_clock::now() > deadline) wait_for_cell(cell, observer, 0ms, wait);
+        if (others_missing && std::chrono::steady_clock::now() > deadline) cell_did_not_come_up(missing, wait);
       }
     } catch (const std::exception& e) {
       store.journal("cellctl", "down", "", std::string("gave up: ") + e.what());

@@ -50,9 +50,7 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer)
     const auto queue = OrderDesk::queue(stored);
     for (const auto& o : stored) {
       json order = {{"order", o.order}, {"state", o.state}, {"reason", o.reason}, {"quote", o.quote}};
-      if (const auto q = std::find(queue.begin(), queue.end(), o.order); q != queue.end()) {
-        order["place"] = q - queue.begin() + 1;  // in the cell's queue, 1 next
-      }
+      if (const std::size_t place = OrderDesk::place_in(queue, o.order)) order["place"] = place;
       orders.push_back(order);
       listed.insert(o.order);
     }

@@ -119,6 +119,16 @@ std::vector<std::string> OrderDesk::queue(const std::vector<state::OrderRecord>&
   return out;
 }
 
+std::size_t OrderDesk::place_in(const std::vector<std::string>& queue, const std::string& order) {
+  const auto q = std::find(queue.begin(), queue.end(), order);
+  return q == queue.end() ? 0 : static_cast<std::size_t>(q - queue.begin()) + 1;
+}
+
+std::string OrderDesk::place_text(const std::vector<std::string>& queue, const std::string& order) {
+  const std::size_t place = place_in(queue, order);
+  return place == 0 ? "" : "place " + std::to_string(place) + " of " + std::to_string(queue.size());
+}
+
 void OrderDesk::interrupt_all() {
   std::vector<Process*> all;
   for (auto& [id, twin] : twins_) all.push_back(twin.process.get());

@@ -45,6 +45,10 @@ class OrderDesk {
   std::size_t running() const { return twins_.size(); }
   // The orders waiting in the queue, first to start first.
   static std::vector<std::string> queue(const std::vector<state::OrderRecord>& orders);
+  // The order's place in it, 1 next; 0 when it does not wait there.
+  static std::size_t place_in(const std::vector<std::string>& queue, const std::string& order);
+  // "place 3 of 5", or "" when it does not wait there.
+  static std::string place_text(const std::vector<std::string>& queue, const std::string& order);
 
  private:
   const CellConfig& cell_;

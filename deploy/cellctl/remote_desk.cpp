@@ -253,9 +253,8 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
 void RemoteDesk::follow(Accepted& a, const std::map<std::string, cell::OrderStatus>& statuses,
                         const std::vector<std::string>& queue) {
   Client& client = *clients_.at(a.client);
-  if (const auto q = std::find(queue.begin(), queue.end(), a.order); q != queue.end()) {
-    const std::string now = "waits in the cell's queue, place " + std::to_string(q - queue.begin() + 1) + " of " +
-                            std::to_string(queue.size());
+  if (const std::string place = OrderDesk::place_text(queue, a.order); !place.empty()) {
+    const std::string now = "waits in the cell's queue, " + place;
     if (now != a.last_state) reply(client, a.submission, a.request, a.order, cell::DESK_PROGRESS, now);
     a.last_state = now;
   } else if (const auto s = statuses.find(a.order); s != statuses.end()) {
