@@ -72,7 +72,7 @@ void Negotiator::receive(const Event& e) {
         (!std::isfinite(start) || !std::isfinite(duration) || duration < 0 || !std::isfinite(bid_time))) {
       c.refusals[resource] = "its bid was not a finite start, bid time and duration >= 0";
     } else if (get<bool>(e.data, "available")) {
-      c.bids[resource] = {resource, start, duration, bid_time};
+      c.bids[resource] = {resource, start, duration, bid_time, get<std::string>(c.data, "operation")};
       c.refusals.erase(resource);
     } else {
       c.refusals[resource] = get<std::string>(e.data, "reason");

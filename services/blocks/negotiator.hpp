@@ -44,6 +44,7 @@ struct Bid {
   double earliest_start = 0;  // sim s
   double duration = 0;        // s
   double bid_time = 0;        // the bidder's sim time when it bid
+  std::string operation;      // the call's
 };
 
 // Which bid wins: the lowest cost. The interface is small so that a cell can weigh bids its

@@ -11,7 +11,10 @@
 //                   A sample the resource's queue has no room for goes to `on_refused`
 //                   (on the listener thread), which answers its sender.
 //   RoutedPublishBlock: REQ (data) -> writes one sample on the topic `route` names for the
-//                   data (a resource's own command topic), a writer per topic, made on first use.
+//                   data (a resource's own command topic), a writer per topic, made on first use;
+//                   PREPARE (data) makes the writer ahead of use, so that it is matched by then
+//                   (a match takes milliseconds, tens under load: sim seconds that the first
+//                   command of an order would otherwise wait).
 
 #include <functional>
 #include <iostream>
@@ -130,22 +133,26 @@ class RoutedPublishBlock : public fb::FunctionBlock {
       : FunctionBlock(std::move(name)), participant_(std::move(participant)), route_(std::move(route)),
         to_sample_(std::move(to_sample)), settings_(settings) {
     declare_input("REQ");
+    declare_input("PREPARE");
     declare_output("CNF");
     declare_output("ERROR", {"reason"});
   }
 
   void receive(const fb::Event& event) override {
-    if (event.name != "REQ") return;
+    if (event.name != "REQ" && event.name != "PREPARE") return;
     try {
       const std::string topic = route_(event.data);
-      auto& writer = writers_[topic];
-      if (!writer) {
-        writer = std::make_unique<Writer<T, PubSubType>>(participant_, topic, TopicKind::events, settings_);
+      Topic& route = writers_[topic];
+      if (!route.writer) route.writer = std::make_unique<Writer<T, PubSubType>>(participant_, topic, TopicKind::events, settings_);
+      if (event.name == "PREPARE") return;
+      if (!route.used) {
         // The reader is there (its resource was hired): wait for the match, which takes
-        // milliseconds between participants that know each other, so the first sample is not lost.
-        writer->wait_for_readers(1, std::chrono::seconds(1));
+        // milliseconds between participants that know each other, so the first sample is not
+        // lost. A writer prepared in time is matched already.
+        route.writer->wait_for_readers(1, std::chrono::seconds(1));
+        route.used = true;
       }
-      if (writer->write(to_sample_(event.data))) return emit("CNF");
+      if (route.writer->write(to_sample_(event.data))) return emit("CNF");
       emit("ERROR", {{"reason", std::string("DDS write failed on ") + topic}});
     } catch (const std::exception& e) {
       emit("ERROR", {{"reason", std::string(e.what())}});
@@ -157,7 +164,11 @@ class RoutedPublishBlock : public fb::FunctionBlock {
   Route route_;
   ToSample to_sample_;
   QosSettings settings_;
-  std::map<std::string, std::unique_ptr<Writer<T, PubSubType>>> writers_;
+  struct Topic {
+    std::unique_ptr<Writer<T, PubSubType>> writer;
+    bool used = false;  // a sample was written
+  };
+  std::map<std::string, Topic> writers_;
 };
 
 }  // namespace dds

@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
     resource.connect("places", "IND", "robot", "PLACE");
     resource.connect("give_events", "IND", "robot", "GIVE_EVENT");
     resource.connect("robot", "GIVE", "gives", "REQ");
+    resource.connect("robot", "PREPARE_GIVE", "gives", "PREPARE");
     node.start(std::chrono::seconds(30), &running);
     places.start();
     give_events.start();

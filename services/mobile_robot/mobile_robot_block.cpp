@@ -18,6 +18,7 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
   declare_input("TICK");
   declare_output("SIM", {"request_id", "kind", "body_id"});
   declare_output("GIVE", {"command_id", "resource_id", "operation", "part_type"});
+  declare_output("PREPARE_GIVE", {"resource_id"});  // a buffer it will fetch from
 
   const auto answered = [this](const Data& d) { return sim_.answers_last(d); };
   const auto arrived = [this](const Data& d) {
@@ -47,6 +48,7 @@ MobileRobotBlock::MobileRobotBlock(std::string name, std::string id, Numbers hom
     transition(state, "AWARDED", state, [this](const Data& d) {
       const auto it = docks_.find(get<std::string>(d, "station"));
       if (it != docks_.end()) work_ends_at_ = it->second;
+      for (const auto& source : split_names(get_or<std::string>(d, "sources", ""))) emit("PREPARE_GIVE", {{"resource_id", source}});
     });
   }
   transition("INIT", "INIT", "SPAWNING", [this, home](const Data&) {

@@ -9,7 +9,8 @@
 //     -> SIM move to the source's dock -> GIVE (a "give" command to the source)
 //     -> GIVE_EVENT succeeded -> SIM move to the destination's dock carrying the part -> DONE
 //   PLACE (resource_id, dock): where a resource hands parts over
-//   AWARDED (sources, station): a batch of fetches it was hired for; it will end there
+//   AWARDED (sources, station): a batch of fetches it was hired for; it will end there;
+//     PREPARE_GIVE (resource_id) for each source: its command writer is made before the first give
 //   TICK (wall time, from its node): a give with no final answer in time is sent again
 // estimate(): how long a batch would take from where its work taken on so far ends.
 

@@ -1,5 +1,7 @@
 #include "sim/world/sim_world.hpp"
 
+#include "sim/world/motion_time.hpp"
+
 #include <algorithm>
 
 namespace sim {
@@ -130,9 +132,7 @@ MoveResult SimWorld::move(const MoveRequest& request) {
   Pose at = start;
   for (const Pose& next : request.path) {
     const double length = (next.translation() - at.translation()).norm();
-    const double angle = Eigen::Quaterniond(at.linear()).angularDistance(Eigen::Quaterniond(next.linear()));
-    const double duration =
-        std::max(length / request.speed, request.angular_speed > 0 ? angle / request.angular_speed : 0.0);
+    const double duration = segment_duration(at, next, request.speed, request.angular_speed);
     std::optional<Contact> contact;
     if (!compound.empty()) contact = world.sweep(compound, at, next, ignore);
     if (!contact && !others.empty()) contact = world.sweep(others, at, next);

@@ -17,6 +17,7 @@
 #include "services/state/cell_store.hpp"
 #include "services/station/arm_block.hpp"
 #include "sim/cell_sim/world_block.hpp"
+#include "sim/world/motion_time.hpp"
 #include "sim/world/sim_world.hpp"
 
 namespace {
@@ -246,12 +247,22 @@ TEST_CASE("cell-sim world: a move takes distance over speed, and stops at the fi
   CHECK(free.duration == Approx(2.0));
   CHECK(world.pose("box")->translation().isApprox(Eigen::Vector3d(0.3, 0.47, 0.4)));  // carried along
 
+  // A turn slower than the translation takes as long as the turn: the rule a twin's quote
+  // times the arm's paths by (sim::segment_duration).
+  sim::Pose turned(Eigen::AngleAxisd(1.5, Eigen::Vector3d::UnitY()));
+  turned.translation() = Eigen::Vector3d(0.3, 0.55, 0.4);  // 0.05 m: 0.2 s
+  const sim::Pose before = *world.pose("pad");
+  const sim::MoveResult turn = world.move({"pad", {"box"}, {turned}, 0.25, 1, "", ""});
+  CHECK(turn.duration == Approx(1.5));
+  CHECK(turn.duration == Approx(sim::segment_duration(before, turned, 0.25, 1)));
+
   // Straight down into the table: the box (carried, 0.03 below the pad) hits it first.
-  const sim::MoveResult hit = world.move({"pad", {"box"}, {sim::Pose(Eigen::Translation3d(0.3, 0.0, 0.4))}, 0.25, 1, "", ""});
+  turned.translation().y() = 0.0;
+  const sim::MoveResult hit = world.move({"pad", {"box"}, {turned}, 0.25, 1, "", ""});
   CHECK(hit.collided);
   CHECK(hit.hit_body == "table");
   CHECK(hit.hit_member == "box");
-  CHECK(hit.distance == Approx(0.45).margin(0.002));
+  CHECK(hit.distance == Approx(0.5).margin(0.002));
   CHECK(hit.duration == Approx(hit.distance / 0.25));
 
   CHECK_THROWS_AS(world.move({"table", {}, {sim::Pose::Identity()}, 1, 1, "", ""}), sim::SimError);

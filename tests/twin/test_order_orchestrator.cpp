@@ -3,7 +3,6 @@
 // what the test says.
 
 #include <functional>
-#include <numeric>
 #include <optional>
 
 #include <catch2/catch.hpp>
@@ -31,7 +30,7 @@ class Outbox : public fb::FunctionBlock {
 
 struct Twin {
   Twin(const twin::LoadedProduct& product, const twin::Plan& plan, bool quote_only = false,
-       twin::OrderSettings::Resume resume = {}, std::chrono::milliseconds resend_after = std::chrono::seconds(2))
+       twin::Resume resume = {}, std::chrono::milliseconds resend_after = std::chrono::seconds(2))
       : resource("twin", 4096) {
     twin::OrderSettings order;
     order.order_id = "o1";
@@ -387,7 +386,7 @@ TEST_CASE("orchestrator: a twin taking up an order whose parts stand does not pl
   const twin::Plan& plan = cranfield.plan;
   const std::string first = "o1/" + cranfield.product.product.parts()[plan.steps[0].part].name;
   const std::string second = "o1/virtual/" + cranfield.product.product.parts()[plan.steps[1].part].name;
-  twin::OrderSettings::Resume resume;
+  twin::Resume resume;
   resume.attempt = 2;
   resume.station = "station-1";
   resume.placed = {first};
@@ -482,15 +481,15 @@ TEST_CASE("orchestrator: an order for a quote assembles virtually, asks for bids
   const Data& q = *out.quote;
   CHECK(get<std::string>(q, "station") == "station-1");
   CHECK(get<std::string>(q, "robot") == "mobile-robot-1");
-  const auto& fetch = get<fb::Numbers>(q, "fetch");
-  const auto& arm = get<fb::Numbers>(q, "arm");
-  REQUIRE(fetch.size() == cranfield.plan.steps.size());
-  REQUIRE(arm.size() == cranfield.plan.steps.size());
-  // The robot's bid (1 s for the batch) shared among the fetches; the arm's time per step
-  // adds up to what the order would ask the station for.
-  CHECK(std::accumulate(fetch.begin(), fetch.end(), 0.0) == Approx(1.0));
-  CHECK(std::accumulate(arm.begin(), arm.end(), 0.0) == Approx(t.orchestrator->physical_estimate()));
-  CHECK(std::all_of(arm.begin(), arm.end(), [](double a) { return a > 0; }));
+  // The stand-in cell's robot stands at the station's place and drives to the one dock of
+  // all (0.6 m at 0.25 m/s) once: the arm waits 2.4 s for the first part, then works as long
+  // as the order would hold the station; the twin knows no real-time factor here, so its
+  // messages take no time.
+  CHECK(get<double>(q, "wait") == 0);
+  CHECK(get<double>(q, "robot_s") == Approx(2.4));
+  const double hold = t.orchestrator->hold_at("station-1");
+  CHECK(hold > 10);
+  CHECK(get<double>(q, "makespan") == Approx(2.4 + hold));
 }
 
 TEST_CASE("orchestrator: a quote nobody can bid on ends with every refusal's reason", "[twin][orchestration][quote]") {
@@ -505,4 +504,32 @@ TEST_CASE("orchestrator: a quote nobody can bid on ends with every refusal's rea
   CHECK_FALSE(out.quote);
   CHECK(out.error.find("buffer-1 has 0 Brick2x2 free") != std::string::npos);
   CHECK(std::none_of(out.order.begin(), out.order.end(), [](const std::string& o) { return o.rfind("AWARD", 0) == 0; }));
+}
+
+TEST_CASE("orchestrator: bids to host the order are weighed by its model at each station, so the faster arm wins",
+          "[twin][orchestration][quote]") {
+  const test::Planned cranfield(test::product("cranfield/cranfield.aml"));
+  Twin t(cranfield.product, cranfield.plan);
+  const auto place = [&t](const std::string& id, const std::string& kind, double z, double speed) {
+    t.send("orchestrator", "CAPABILITY",
+           {{"resource_id", id}, {"kind", kind}, {"operations", std::string()}, {"position", fb::Numbers{0, 0, z}},
+            {"dock", fb::Numbers{0.6, 0, z}}, {"speed", speed}, {"angular_speed", 1.0}, {"reserved_by", std::string()},
+            {"waiting", std::string()}});
+  };
+  place("station-1", "station", 0, 0);
+  place("arm-1", "arm", 0, 0.1);
+  place("station-2", "station", 3, 0);
+  place("arm-2", "arm", 3, 0.4);
+  const double slow = t.orchestrator->hold_at("station-1"), fast = t.orchestrator->hold_at("station-2");
+  CHECK(slow == Approx(4 * fast).epsilon(0.05));  // the same work at a quarter of the speed (turns aside)
+  CHECK(t.orchestrator->hold_at("station-3") < 0);  // not heard of
+
+  // Both offer the same: the order's own estimate, from now. The faster arm finishes first,
+  // unless its queue holds the order up longer than the slower arm takes.
+  const twin::ModelledFinish finish(*t.orchestrator);
+  const auto bid = [](const std::string& station, double start) { return fb::Bid{station, start, 1.0, 0, "host"}; };
+  CHECK(finish.cost(bid("station-2", 0)) < finish.cost(bid("station-1", 0)));
+  CHECK(finish.cost(bid("station-2", slow)) > finish.cost(bid("station-1", 0)));
+  CHECK(finish.cost(bid("station-3", 5)) == 6);  // not heard of: its bid's duration
+  CHECK(finish.cost(fb::Bid{"mobile-robot-1", 2, 3, 0, "fetch"}) == 5);
 }

@@ -1,16 +1,15 @@
-// A quote's time and cost from the bids and the measured times (twin/orchestration/quote).
+// A quote's cost from the modelled times, and quote.json (twin/orchestration/quote).
 
 #include <catch2/catch.hpp>
 
 #include "twin/orchestration/quote.hpp"
 
-TEST_CASE("quote: the fetches and the arm as a two-stage flow, after the station's queue", "[twin][quote]") {
-  twin::QuoteBids bids{"station-2", "mobile-robot-1", 30, 0, {4, 4, 4}, {10, 1, 10}};
-  twin::Rates rates{50, {{"station-2", 360}, {"mobile-robot-1", 36}, {"station-1", 1e6}}, "CHF"};
-  const twin::Quote q = twin::estimate_quote(bids, rates);
+TEST_CASE("quote: the order holds the station from its wait to its makespan and the robot while it drives, each at its rate",
+          "[twin][quote]") {
+  const twin::Rates rates{50, {{"station-2", 360}, {"mobile-robot-1", 36}, {"station-1", 1e6}}, "CHF"};
+  const twin::Quote q = twin::price_quote({"station-2", "mobile-robot-1", 30, 55, 12}, rates);
   CHECK(q.feasible);
-  CHECK(q.wait_s == Approx(30));  // the station is free in 30 s
-  // From 30: parts delivered at 34, 38, 42; the arm: 34-44, 44-45, 45-55.
+  CHECK(q.wait_s == Approx(30));
   CHECK(q.makespan_s == Approx(55));
   CHECK(q.station_s == Approx(25));
   CHECK(q.robot_s == Approx(12));
@@ -18,14 +17,6 @@ TEST_CASE("quote: the fetches and the arm as a two-stage flow, after the station
   CHECK(q.robot_cost == Approx(12.0 / 3600 * 36));
   CHECK(q.total_cost == Approx(50 + 2.5 + 0.12));
   CHECK(q.currency == "CHF");
-
-  // A robot busy past the station's start holds the arm up.
-  bids.robot_wait = 50;
-  bids.station_wait = 0;
-  const twin::Quote later = twin::estimate_quote(bids, rates);
-  CHECK(later.wait_s == 0);
-  CHECK(later.makespan_s == Approx(75));  // delivered 54, 58, 62; arm 54-64, 64-65, 65-75
-  CHECK(later.station_s == Approx(75));
 }
 
 TEST_CASE("quote: quote.json says feasible or why not, the time and the cost, and every finding", "[twin][quote]") {
@@ -37,7 +28,7 @@ TEST_CASE("quote: quote.json says feasible or why not, the time and the cost, an
   CHECK(no["feasible"] == false);
   CHECK(no["reason"] == "nobody offered give Shaft");
   CHECK_FALSE(no.contains("cost"));
-  const auto yes = twin::quote_json("o1", twin::estimate_quote({"station-1", "mobile-robot-1", 0, 0, {1}, {2}}, rates), 1, findings);
+  const auto yes = twin::quote_json("o1", twin::price_quote({"station-1", "mobile-robot-1", 0, 3, 1}, rates), 1, findings);
   CHECK(yes["feasible"] == true);
   CHECK(yes["time_s"]["makespan"] == Approx(3));
   CHECK(yes["cost"]["total"] == Approx(20));

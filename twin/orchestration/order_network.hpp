@@ -6,7 +6,7 @@
 //
 //   into "orchestrator": START, TICK, CAPABILITY, RESOURCE_GONE, COMMAND_EVENT, SIM_REPLY
 //   into "negotiator":   TICK, CAPABILITY, RESOURCE_GONE, PROPOSAL, AWARD_REPLY
-//   out of "orchestrator": RELEASE, COMMAND, CANCEL, SIM, STATUS, FINDING, PLACED, QUOTE, FINISHED
+//   out of "orchestrator": RELEASE, PREPARE, COMMAND, CANCEL, SIM, STATUS, FINDING, PLACED, QUOTE, FINISHED
 //   out of "negotiator":   CFP, AWARD
 
 #include <memory>
@@ -17,11 +17,29 @@
 
 namespace twin {
 
+// The earliest finish, where a station's time to host the order is the order's own model of
+// its assembly there (OrderOrchestrator::hold_at: that station's arm, dock and table), not
+// the one estimate every station was called with: a faster arm takes the order. Other bids
+// finish when they say.
+class ModelledFinish : public fb::BidEvaluator {
+ public:
+  explicit ModelledFinish(const OrderOrchestrator& orchestrator) : orchestrator_(orchestrator) {}
+  double cost(const fb::Bid& bid) const override {
+    const double hold = bid.operation == "host" ? orchestrator_.hold_at(bid.resource_id) : -1;
+    return bid.earliest_start + (hold >= 0 ? hold : bid.duration);
+  }
+
+ private:
+  const OrderOrchestrator& orchestrator_;
+};
+
+// `evaluator`: nullptr weighs bids by ModelledFinish.
+
 inline OrderOrchestrator& add_order_network(fb::Resource& resource, const LoadedProduct& product, const Plan& plan,
                                             const OrderSettings& order, const fb::NegotiationSettings& negotiation,
-                                            std::shared_ptr<const fb::BidEvaluator> evaluator =
-                                                std::make_shared<fb::EarliestFinish>()) {
+                                            std::shared_ptr<const fb::BidEvaluator> evaluator = nullptr) {
   auto& orchestrator = resource.add(std::make_unique<OrderOrchestrator>("orchestrator", product, plan, order));
+  if (!evaluator) evaluator = std::make_shared<ModelledFinish>(orchestrator);
   resource.add(std::make_unique<fb::Negotiator>("negotiator", order.order_id, negotiation, std::move(evaluator)));
   resource.connect("orchestrator", "CALL", "negotiator", "CALL");
   resource.connect("orchestrator", "ASK", "negotiator", "ASK");

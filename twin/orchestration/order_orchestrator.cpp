@@ -13,33 +13,9 @@
 namespace twin {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 using fb::Data;
 using fb::get;
 using fb::Numbers;
-
-Pose with_translation(Pose pose, double x, double y, double z) {
-  pose.translation() = Vec3(x, y, z);
-  return pose;
-}
-
-// A part (or a subassembly) standing at `from` carried to where its trajectory starts: up to
-// the higher of the two (at least `least`), over, then down to the start.
-std::vector<Pose> lift_over(const Pose& from, const Pose& start, double least) {
-  const double safe = std::max({from.translation().y(), start.translation().y(), least});
-  return {with_translation(from, from.translation().x(), safe, from.translation().z()),
-          with_translation(start, start.translation().x(), safe, start.translation().z()), start};
-}
-
-// The step puts a whole subassembly in (its part is the base; `carried`, the other members).
-bool inserts_unit(const PlanStep& step) { return !step.carried.empty(); }
-
-double path_length(const std::vector<Pose>& poses) {
-  double length = 0;
-  for (std::size_t i = 1; i < poses.size(); ++i) length += (poses[i].translation() - poses[i - 1].translation()).norm();
-  return length;
-}
 
 const std::string kHost = "host", kArm = "arm", kRobot = "robot", kGive = "give/";
 
@@ -63,6 +39,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_output("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_output("QUOTE", {"station", "station_wait", "robot", "robot_wait", "fetch", "arm"});
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
+  declare_output("PREPARE", {"resource_id"});
   declare_output("STATUS", {"state", "message", "progress"});
   declare_output("FINDING", {"kind", "message", "part"});
   declare_output("PLACED", {"part", "aside"});
@@ -221,34 +198,41 @@ const OrderOrchestrator::Place* OrderOrchestrator::arm_at(const std::string& sta
   return nullptr;
 }
 
-// Until the arm's capability is heard, at the speed virtual assembly used.
-std::vector<double> OrderOrchestrator::arm_times() const {
-  const std::string& station = station_.empty() ? virtual_station_ : station_;
-  const Numbers dock = places_.count(station) ? places_.at(station).dock : Numbers{0.6, 0, 0};
-  const Place* arm = arm_at(station);
-  const double speed = arm ? arm->speed : settings_.arm_speed;
-  std::vector<double> out;
-  for (const auto& step : plan_.steps) {
-    const auto& w = step.trajectory.waypoints;
-    std::vector<Pose> poses;
-    for (const auto& p : w) {
-      if (p.phase != "screw") poses.push_back(p.gripper);  // a helix is timed by its turns, below
-    }
-    // From the dock (or where its subassembly stands aside) to where the trajectory starts,
-    // along it, and back.
-    const SubassemblyPlan* unit = inserts_unit(step) ? subassembly_of(step) : nullptr;
-    const Vec3 from = unit ? aside_pose(step.part, *unit).translation() : Vec3(dock[0], dock[1], dock[2]);
-    const double to_start = (w.front().part.translation() - from).norm();
-    // A screw's helix takes as long as its turns at the arm's angular speed, where that is longer.
-    const double turning = step.trajectory.screw ? 2 * kPi * step.trajectory.screw->turns / settings_.arm_angular_speed : 0;
-    out.push_back((2 * to_start + path_length(poses)) / speed + turning);
+// The station's arm once its capability is heard; until then, at the speed virtual assembly
+// used. A robot not known drives in no time; a place not known is the station's.
+ModelledRun OrderOrchestrator::modelled(const Hired& h, double station_free, double robot_free) const {
+  PhysicalScript script;
+  {
+    fb::SimRequests sim("model");
+    std::size_t count = 0;
+    script = physical_script(product_, plan_, geometry_, h, settings_.resume, sim,
+                             [&count](const std::string& resource, const std::string& operation, const std::string& part) {
+                               return Data{{"command_id", "model/" + std::to_string(++count)}, {"resource_id", resource},
+                                           {"operation", operation}, {"part", part}};
+                             });
   }
-  return out;
+  ResourceModels models;
+  for (const auto& [id, place] : h.places) models.docks[id] = place.dock;
+  const Numbers& station_dock = h.places.at(h.station).dock;
+  const auto robot = places_.find(h.robot);
+  const bool robot_known = robot != places_.end() && robot->second.speed > 0 && robot->second.position.size() >= 3;
+  models.robot_at = robot_known ? robot->second.position : station_dock;
+  models.robot_speed = robot_known ? robot->second.speed : std::numeric_limits<double>::infinity();
+  const Place* arm = arm_at(h.station);
+  models.arm_speed = arm ? arm->speed : settings_.arm_speed;
+  models.arm_angular_speed = arm ? arm->angular_speed : settings_.arm_angular_speed;
+  models.real_time_factor = settings_.real_time_factor ? settings_.real_time_factor() : 0;
+  return run_script(script.actions, models, station_free, robot_free);
 }
 
-double OrderOrchestrator::physical_estimate() const {
-  const auto times = arm_times();
-  return std::accumulate(times.begin(), times.end(), 0.0);
+double OrderOrchestrator::hold_at(const std::string& station) const {
+  if (!places_.count(station)) return -1;
+  // Every part at the dock already: what the arm does there.
+  Hired h{settings_.order_id, station, "arm", "", {}, {}};
+  h.places[station] = location(station);
+  for (const auto& [type, count] : parts_per_type()) h.buffer_of[type] = station;
+  const ModelledRun run = modelled(h, 0, 0);
+  return run.end - run.start;
 }
 
 Data OrderOrchestrator::call_data(const std::string& what, const std::string& operation, const std::string& type,
@@ -265,7 +249,7 @@ void OrderOrchestrator::book(std::string only) {
   waiting_since_ = std::chrono::steady_clock::now();
   const std::string why = only == settings_.resume.station ? ", where its parts stand" : ", whose queue is shorter";
   status("WAITING", only.empty() ? "virtual assembly done; booking a station" : "booking " + only + why, 0);
-  emit("CALL", call_data(kHost, kHost, "", only, "", 0, physical_estimate()));
+  emit("CALL", call_data(kHost, kHost, "", only, "", 0, std::max(0.0, hold_at(only.empty() ? virtual_station_ : only))));
 }
 
 // Orders booked at the same moment see the same bids and may crowd one station: an order
@@ -328,7 +312,7 @@ std::map<std::string, int> OrderOrchestrator::parts_per_type() const {
 void OrderOrchestrator::hire() {
   enter("HIRING");
   status("WAITING", station_ + " is ours; hiring its arm, a mobile robot and buffers", 0);
-  emit("CALL", call_data(kArm, "translate", "", station_, "", 0, physical_estimate()));
+  emit("CALL", call_data(kArm, "translate", "", station_, "", 0, hold_at(station_)));
   for (const auto& [type, count] : parts_per_type()) emit("CALL", call_data(kGive + type, "give", type, station_, "", count, 0));
   call_robot_when_ready("CALL");
 }
@@ -347,6 +331,8 @@ void OrderOrchestrator::on_awarded(const Data& d) {
     if (ahead_ < 0) report_place(ahead);
     return;
   }
+  // Its commands' writer is made now: matched by the first command.
+  if (what == kArm || what == kRobot) emit("PREPARE", {{"resource_id", resource}});
   if (what == kArm) {
     arm_ = resource;
     arm_held_ = ahead == 0 || places_[arm_].reserved_by == settings_.order_id;
@@ -376,7 +362,7 @@ void OrderOrchestrator::ask_for_quotes() {
   enter("QUOTING");
   waiting_since_ = std::chrono::steady_clock::now();
   status("WAITING", "virtual assembly done; asking the cell's resources for quotes", 0);
-  emit("ASK", call_data(kHost, kHost, "", "", "", 0, physical_estimate()));
+  emit("ASK", call_data(kHost, kHost, "", "", "", 0, std::max(0.0, hold_at(virtual_station_))));
   for (const auto& [type, count] : parts_per_type()) emit("ASK", call_data(kGive + type, "give", type, "", "", count, 0));
 }
 
@@ -397,62 +383,35 @@ void OrderOrchestrator::on_quoted(const Data& d) {
   } else if (what == kRobot) {
     robot_ = resource;
     robot_wait_ = queue_of(d);
-    robot_duration_ = get<double>(d, "duration");
     return quote_when_arm_known();
   }
   call_robot_when_ready("ASK");
 }
 
-// The arm's times need its speed: its capability may come later than the station's.
+// The arm's model needs its speed: its capability may come later than the station's. The
+// station is the order's after its queue; the robot sets out once the station is the
+// order's and its own earlier work is done.
 void OrderOrchestrator::quote_when_arm_known() {
-  if (robot_.empty() || !arm_at(station_)) return;
-  emit("QUOTE", {{"station", station_}, {"station_wait", station_wait_}, {"robot", robot_},
-                 {"robot_wait", robot_wait_}, {"fetch", fetch_times()}, {"arm", arm_times()}});
+  if (robot_.empty() || !arm_at(station_) || !knows_places()) return;
+  const ModelledRun run = modelled(hired(), station_wait_, robot_wait_);
+  emit("QUOTE", {{"station", station_}, {"robot", robot_}, {"wait", run.start}, {"makespan", run.end},
+                 {"robot_s", run.robot_s}});
   enter("ENDED");
   emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
-}
-
-// The robot's bid is for the whole batch; each fetch gets its share by the distance it drives
-// (from where the robot stands to the buffer's dock, then to the station's), as the robot
-// itself estimates it. Places not known: equal shares.
-std::vector<double> OrderOrchestrator::fetch_times() const {
-  const auto dock = [this](const std::string& id) -> const Numbers* {
-    const auto it = places_.find(id);
-    return it == places_.end() || it->second.dock.size() < 3 ? nullptr : &it->second.dock;
-  };
-  const auto flat = [](const Numbers& a, const Numbers& b) { return std::hypot(a[0] - b[0], a[2] - b[2]); };
-  std::vector<double> distances;
-  const Numbers* to = dock(station_);
-  const auto robot = places_.find(robot_);
-  const Numbers* at = robot == places_.end() || robot->second.position.size() < 3 ? nullptr : &robot->second.position;
-  for (const auto& step : plan_.steps) {
-    if (inserts_unit(step)) {  // its parts came with their own steps
-      distances.push_back(0);
-      continue;
-    }
-    const Numbers* from = dock(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
-    if (!to || !at || !from) break;
-    distances.push_back(flat(*at, *from) + flat(*from, *to));
-    at = to;
-  }
-  const double total = std::accumulate(distances.begin(), distances.end(), 0.0);
-  const std::size_t n = plan_.steps.size();
-  std::vector<double> out(n, n ? robot_duration_ / n : 0);
-  if (distances.size() == n && total > 0) {
-    for (std::size_t i = 0; i < n; ++i) out[i] = robot_duration_ * distances[i] / total;
-  }
-  return out;
 }
 
 // Also once the places of the station and the buffers are known: a resource's proposal may
 // come before its capability (DDS matches each pair of endpoints on its own).
 void OrderOrchestrator::start_physical_when_hired() {
-  if (state() != "HIRING" || robot_.empty() || arm_.empty() || !arm_held_ || !places_.count(station_)) return;
-  for (const auto& [type, buffer] : buffer_of_) {
-    if (!places_.count(buffer)) return;
-  }
+  if (state() != "HIRING" || robot_.empty() || arm_.empty() || !arm_held_ || !knows_places()) return;
   enter("PHYSICAL");
   plan_physical();
+}
+
+bool OrderOrchestrator::knows_places() const {
+  return places_.count(station_) && std::all_of(buffer_of_.begin(), buffer_of_.end(), [this](const auto& b) {
+           return places_.count(b.second) > 0;
+         });
 }
 
 // --- scripts -------------------------------------------------------------------------------
@@ -468,91 +427,20 @@ std::vector<Trajectory> OrderOrchestrator::candidates(std::size_t step) const {
   return out;
 }
 
-// The robot puts a part down at the station's dock at the height it has in the product,
-// turned as it goes in (`start`: where its trajectory starts, in the cell).
-Pose OrderOrchestrator::at_dock(const std::string& station, PartIndex part, const Pose& start) const {
-  const Numbers& dock = places_.at(station).dock;
-  const double height = at(station, product_.product.parts()[part].final_pose).translation().y();
-  return with_translation(start, dock[0], height, dock[2]);
-}
-
-OrderOrchestrator::Carry OrderOrchestrator::carry(const std::string& station, std::size_t index, const Trajectory& t,
-                                                  const Pose& standing) const {
-  const auto& w = t.waypoints;
-  const Pose grip = w.front().part.inverse() * w.front().gripper;
-  const double least = carry_height(index, w.front().part) + places_.at(station).position[1];
-  Carry c;
-  for (const Pose& p : lift_over(standing, at(station, w.front().part), least)) c.holding.push_back(p * grip);
-  for (std::size_t i = 1; i < w.size(); ++i) {
-    (w[i].holding ? c.holding : c.retreat).push_back(at(station, w[i].gripper));
-    if (w[i].phase == "screw") ++c.turning;
-  }
-  return c;
-}
-
-Pose OrderOrchestrator::at(const std::string& station, const Pose& pose) const {
-  const Numbers& p = places_.at(station).position;
-  Pose offset = Pose::Identity();
-  offset.translation() = Vec3(p[0], p[1], p[2]);
-  return offset * pose;
-}
-
-Numbers OrderOrchestrator::pose_numbers(const std::vector<Pose>& poses) const {
-  Numbers out;
-  for (const Pose& p : poses) {
-    const Numbers seven = fb::pose_numbers(p);
-    out.insert(out.end(), seven.begin(), seven.end());
-  }
-  return out;
-}
-
 std::string OrderOrchestrator::virtual_body(PartIndex part) const {
   return settings_.order_id + "/virtual/" + product_.product.parts()[part].name;
 }
 
-std::string OrderOrchestrator::physical_body(PartIndex part) const {
-  return settings_.order_id + "/" + product_.product.parts()[part].name;
+Location OrderOrchestrator::location(const std::string& resource) const {
+  const Place& p = places_.at(resource);
+  return {p.position, p.dock};
 }
 
-const SubassemblyPlan* OrderOrchestrator::subassembly_of(const PlanStep& step) const {
-  for (const auto& unit : plan_.subassemblies) {
-    if (unit.name == step.subassembly) return &unit;
-  }
-  return nullptr;
-}
-
-double OrderOrchestrator::carry_height(std::size_t index, const Pose& pose) const {
-  constexpr double kClearance = 0.02;  // m
-  const PlanStep& step = plan_.steps[index];
-  double top = -std::numeric_limits<double>::infinity();
-  for (const auto& unit : plan_.subassemblies) top = std::max(top, final_bounds(product_, unit.members).max().y() + unit.aside.y());
-  // The parts in the product already (a carry at the height its trajectory starts went
-  // through the tower it was to go on).
-  for (std::size_t i = 0; i < index; ++i) {
-    if (!plan_.steps[i].subassembly.empty()) continue;  // built aside: the asides' tops above
-    std::vector<PartIndex> in_place{plan_.steps[i].part};
-    in_place.insert(in_place.end(), plan_.steps[i].carried.begin(), plan_.steps[i].carried.end());
-    top = std::max(top, final_bounds(product_, in_place).max().y());
-  }
-  if (!std::isfinite(top)) return top;
-  // How far the moving parts reach below `pose`, turned as it is.
-  const Pose& base = product_.product.parts()[step.part].final_pose;
-  std::vector<PartIndex> moving{step.part};
-  moving.insert(moving.end(), step.carried.begin(), step.carried.end());
-  Pose turned = Pose::Identity();
-  turned.linear() = pose.rotation();
-  double below = 0;
-  for (PartIndex p : moving) {
-    const Pose offset = turned * base.inverse() * product_.product.parts()[p].final_pose;
-    for (const auto& v : product_.meshes[p]->vertices) below = std::min(below, (offset * v).y());
-  }
-  return top + kClearance - below;
-}
-
-Pose OrderOrchestrator::aside_pose(PartIndex part, const SubassemblyPlan& unit) const {
-  Pose pose = product_.product.parts()[part].final_pose;
-  pose.pretranslate(unit.aside);
-  return pose;
+Hired OrderOrchestrator::hired() const {
+  Hired h{settings_.order_id, station_, arm_, robot_, buffer_of_, {}};
+  h.places[station_] = location(station_);
+  for (const auto& [type, buffer] : buffer_of_) h.places[buffer] = location(buffer);
+  return h;
 }
 
 Data OrderOrchestrator::command(const std::string& resource, const std::string& operation, const std::string& part) {
@@ -575,7 +463,8 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   const MeshRef& mesh = *product_.product.parts()[part].mesh;
   // Where the robot puts it down, and carried from there as the cell's arm will carry it
   // (plan_physical): the carry is checked too, not only the trajectory.
-  const Pose start = at(virtual_station_, w.front().part), standing = at_dock(virtual_station_, part, start);
+  const Location here = location(virtual_station_);
+  const Pose start = geometry_.at(here, w.front().part), standing = geometry_.at_dock(here, part, start);
   const Pose grip = w.front().part.inverse() * w.front().gripper;
   actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({standing}), {0, 0, 0}, false, mesh.file.string(), scene,
                                               mesh.scale)});
@@ -587,7 +476,7 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   }
   spawned_.insert(body);
   spawned_.insert(gripper.begin(), gripper.end());
-  const auto [holding, retreat, turning] = carry(virtual_station_, step, t, standing);
+  const auto [holding, retreat, turning] = geometry_.carry(here, step, t, standing);
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
   // The palm leads; the fingers, the carriage and (while held) the part go with it; along a
   // helix at the end, the part turns into its mate's thread.
@@ -619,21 +508,22 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
 // its base, up and over to the trajectory, along it, backing out.
 void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t) {
   const PlanStep& unit_step = plan_.steps[step];
-  const SubassemblyPlan* unit = subassembly_of(unit_step);
+  const SubassemblyPlan* unit = geometry_.subassembly_of(unit_step);
   const std::string& scene = settings_.order_id;
+  const Location here = location(virtual_station_);
   std::vector<PartIndex> members{unit_step.part};
   members.insert(members.end(), unit_step.carried.begin(), unit_step.carried.end());
   for (PartIndex member : members) {
     const std::string body = virtual_body(member);
     const MeshRef& mesh = *product_.product.parts()[member].mesh;
     actions_.push_back({Action::sim, sim_.remove(body), false, true});
-    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({at(virtual_station_, aside_pose(member, *unit))}),
+    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({geometry_.at(here, geometry_.aside_pose(member, *unit))}),
                                                 {0, 0, 0}, false, mesh.file.string(), scene, mesh.scale)});
     spawned_.insert(body);
   }
   const auto& w = t.waypoints;
   const Pose grip = w.front().part.inverse() * w.front().gripper;
-  const Pose standing = at(virtual_station_, aside_pose(unit_step.part, *unit));
+  const Pose standing = geometry_.at(here, geometry_.aside_pose(unit_step.part, *unit));
   const std::vector<std::string> gripper = virtual_gripper();
   const auto boxes = fb::gripper_boxes(settings_.gripper, t.grasp.opening);
   for (std::size_t i = 0; i < boxes.size(); ++i) {
@@ -642,7 +532,7 @@ void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t
                                                 {h.x(), h.y(), h.z()}, false, "", scene)});
   }
   spawned_.insert(gripper.begin(), gripper.end());
-  const auto [holding, retreat, turning] = carry(virtual_station_, step, t, standing);
+  const auto [holding, retreat, turning] = geometry_.carry(here, step, t, standing);
   const double v = settings_.arm_speed, omega = settings_.arm_angular_speed;
   std::vector<std::string> carried(gripper.begin() + 1, gripper.end());
   for (PartIndex member : members) carried.push_back(virtual_body(member));
@@ -730,60 +620,6 @@ void OrderOrchestrator::back_to_sequence_planning() {
   next_action();
 }
 
-// After the grip: move along the gripper's poses while holding, release, back out, connect.
-// A step that holds its part (PlanStep::hold: it stands only once fastened) connects before
-// the release, the gripper still on the part.
-void OrderOrchestrator::add_arm_moves(const std::vector<std::string>& bodies, const Carry& carry, const std::string& aside,
-                                      bool hold, const Screw* screw, const std::string& into) {
-  const std::size_t turning = screw ? carry.turning : 0;
-  const std::vector<Pose> holding(carry.holding.begin(), carry.holding.end() - static_cast<std::ptrdiff_t>(turning));
-  const bool turns = std::any_of(holding.begin(), holding.end(),
-                                 [&](const Pose& p) { return !p.linear().isApprox(holding.front().linear(), 1e-9); });
-  if (!holding.empty()) {
-    Data move = command(arm_, turns ? "rotate" : "translate", bodies.front());
-    move["path"] = pose_numbers(holding);
-    actions_.push_back({Action::command, move});
-  }
-  if (turning > 0) {
-    Data turn = command(arm_, "screw", bodies.front());
-    turn["path"] = pose_numbers({carry.holding.end() - static_cast<std::ptrdiff_t>(turning), carry.holding.end()});
-    turn["turns"] = screw->turns;
-    turn["pitch"] = screw->pitch;
-    turn["destination"] = into;
-    actions_.push_back({Action::command, turn});
-  }
-  const auto connect = [&] {
-    for (const auto& body : bodies) actions_.push_back({Action::command, command(arm_, "connect", body)});
-  };
-  if (hold) connect();
-  Data release = command(arm_, "release", bodies.front());
-  // The state records where the parts go with the release (CellStore::release).
-  release["destination"] = aside.empty() ? std::string("product") : "aside:" + aside;
-  placed_by_[get<std::string>(release, "command_id")] = {{"part", fb::join_names(bodies)}, {"aside", aside}};
-  actions_.push_back({Action::command, release});
-  Data back = command(arm_, "translate", bodies.front());
-  back["path"] = pose_numbers(carry.retreat);
-  actions_.push_back({Action::command, back});
-  if (!hold) connect();
-}
-
-namespace {
-
-// The body that stands for a step's part among `bodies`: its first one, or one a later twin
-// fetched anew ("<body>/rN").
-const std::string* body_in(const std::set<std::string>& bodies, const std::string& body) {
-  for (const std::string& b : bodies) {
-    if (b == body) return &b;
-    if (b.size() > body.size() + 2 && b.compare(0, body.size(), body) == 0 && b.compare(body.size(), 2, "/r") == 0 &&
-        std::all_of(b.begin() + body.size() + 2, b.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
-      return &b;
-    }
-  }
-  return nullptr;
-}
-
-}  // namespace
-
 void OrderOrchestrator::plan_physical() {
   const auto& resume = settings_.resume;
   status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ +
@@ -792,101 +628,14 @@ void OrderOrchestrator::plan_physical() {
                                                                   (resume.aside.empty() ? "" : std::to_string(resume.aside.size()) + " built aside, ") +
                                                                   std::to_string(resume.delivered.size()) + " at the dock)"),
          0);
-  // A part set aside (or given back) by the earlier attempt leaves the scene; a new one comes.
-  for (const auto& body : resume.used) {
-    if (!resume.placed.count(body) && !resume.delivered.count(body)) {
-      actions_.push_back({Action::sim, sim_.remove(body), false, true});
-    }
-  }
-  std::vector<std::string> fetches, bodies;  // per step to do: what to await ("": nothing), its body
-  std::vector<std::size_t> steps;              // the steps to do
-  std::map<PartIndex, std::string> body_of;
-  for (std::size_t i = 0; i < plan_.steps.size(); ++i) {
-    const auto& step = plan_.steps[i];
-    if (inserts_unit(step)) {  // its parts were built aside by the steps before
-      if (!body_in(resume.placed, body_of.at(step.part))) {
-        steps.push_back(i);
-        fetches.emplace_back();
-        bodies.push_back(body_of.at(step.part));
-      }
-      continue;
-    }
-    const auto& part = product_.product.parts()[step.part];
-    const std::string type = short_type_name(part.type);
-    const Pose final_pose = at(station_, part.final_pose);
-    std::string body = physical_body(step.part);
-    const std::string mesh = part.mesh->file.string();
-    const double scale = part.mesh->scale;
-    const std::string* placed = body_in(resume.placed, body);  // done: it stands in the product
-    const SubassemblyPlan* unit = subassembly_of(step);
-    // Done: it stands in its subassembly aside (a state that says so of a part this plan
-    // builds into none is not taken: the part is fetched anew).
-    const std::string* aside = unit ? body_in(resume.aside, body) : nullptr;
-    if (placed || aside) {
-      body = placed ? *placed : *aside;
-      const Pose where = placed ? final_pose : at(station_, aside_pose(step.part, *unit));
-      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({where}), {0, 0, 0}, true, mesh, "", scale)});
-      spawned_.insert(body);
-      body_of[step.part] = body;
-      continue;
-    }
-    steps.push_back(i);
-    if (const std::string* delivered = body_in(resume.delivered, body)) {  // at the dock, where a robot put it down
-      body = *delivered;
-      const Pose down = at_dock(station_, step.part, at(station_, step.trajectory.waypoints.front().part));
-      actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({down}), {0, 0, 0}, false, mesh, "", scale)});
-      spawned_.insert(body);
-      fetches.push_back("delivered/" + body);
-      delivered_.insert(fetches.back());
-      bodies.push_back(body);
-      body_of[step.part] = body;
-      continue;
-    }
-    if (body_in(resume.used, body)) body += "/r" + std::to_string(resume.attempt);  // the one before was set aside
-    const std::string& buffer = buffer_of_.at(type);
-    const Numbers& source = places_.at(buffer).dock;
-    const Pose in_buffer = with_translation(final_pose, source[0], final_pose.translation().y(), source[2]);
-    actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({in_buffer}), {0, 0, 0}, false, mesh, "", scale)});
-    spawned_.insert(body);
-    bodies.push_back(body);
-    body_of[step.part] = body;
-    Data fetch = command(robot_, "fetch", body);
-    fetch["part_type"] = type;
-    fetch["source"] = buffer;
-    fetch["destination"] = station_;
-    fetch["source_award"] = settings_.order_id + "/" + kGive + type;
-    fetch_of_[get<std::string>(fetch, "command_id")] = step.part;
-    fetches.push_back(get<std::string>(fetch, "command_id"));
-    actions_.push_back({Action::send_heard, fetch});
-  }
-  for (std::size_t k = 0; k < steps.size(); ++k) {
-    const PlanStep& step = plan_.steps[steps[k]];
-    const Trajectory& t = step.trajectory;
-    const auto& w = t.waypoints;
-    const SubassemblyPlan* unit = subassembly_of(step);
-    std::vector<std::string> moved{bodies[k]};
-    for (PartIndex p : step.carried) moved.push_back(body_of.at(p));
-    const Pose grip = w.front().part.inverse() * w.front().gripper;
-    const Pose start = at(station_, w.front().part);
-    Pose standing;  // where the arm grips it
-    if (inserts_unit(step)) {
-      // Built aside and connected there: movable again, gripped by its base.
-      standing = at(station_, aside_pose(step.part, *unit));
-      for (const auto& body : moved) actions_.push_back({Action::command, command(arm_, "disconnect", body)});
-    } else {
-      actions_.push_back({Action::await_delivery, {{"command_id", fetches[k]}}});
-      standing = at_dock(station_, step.part, start);
-    }
-    // Carried up from where it stands, over to where the trajectory starts, then along it.
-    Data take = command(arm_, "grip", bodies[k]);
-    take["path"] = pose_numbers({standing * grip});
-    take["opening"] = t.grasp.opening;
-    take["carried"] = fb::join_names({moved.begin() + 1, moved.end()});
-    actions_.push_back({Action::command, take});
-    const auto into = t.screw ? body_of.find(t.screw->mate) : body_of.end();
-    add_arm_moves(moved, carry(station_, steps[k], t, standing), unit && !inserts_unit(step) ? unit->name : "", step.hold,
-                  into != body_of.end() ? &*t.screw : nullptr, into != body_of.end() ? into->second : "");
-  }
+  PhysicalScript script = physical_script(product_, plan_, geometry_, hired(), resume, sim_,
+                                          [this](const std::string& resource, const std::string& operation,
+                                                 const std::string& part) { return command(resource, operation, part); });
+  actions_.insert(actions_.end(), script.actions.begin(), script.actions.end());
+  fetch_of_ = std::move(script.fetch_of);
+  placed_by_ = std::move(script.placed_by);
+  delivered_.insert(script.delivered.begin(), script.delivered.end());
+  spawned_.insert(script.spawned.begin(), script.spawned.end());
   next_action();
 }
 

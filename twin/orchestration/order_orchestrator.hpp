@@ -33,8 +33,9 @@
 // An order for a quote (OrderSettings::quote_only) goes from VIRTUAL to
 //   QUOTING      calls for quotes (the Negotiator's ASK: bids, nothing awarded): a station,
 //                a buffer per part type, then a mobile robot for the batch; once the
-//                station's arm has said its speed, QUOTE with the best bids and the time
-//                each part and step takes, then ENDED; FINISHED. A
+//                station's arm has said its speed, QUOTE: the physical script at the best
+//                bids' station, with their robot and buffers, run against the resources'
+//                models after their queues (execution_model.hpp), then ENDED; FINISHED. A
 //                call nobody bids on fails the order with every refusal's reason.
 // A failure anywhere cancels undelivered fetches and goes through CLEANUP to ENDED.
 //
@@ -47,9 +48,10 @@
 //           resource_id, ahead), QUOTED (call_id, resource_id, earliest_start, duration, bid_time),
 //           UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,
 //           order_id, state, reason, sim_time), SIM_REPLY (request_id, ok, error, collided, ...)
-//   outputs: CALL and ASK (to the Negotiator), QUOTE (station, station_wait, robot,
-//            robot_wait: s of their queues; fetch: s per step (0 for a subassembly's insertion), arm: s per
-//            step), RELEASE, COMMAND, CANCEL (fetches not delivered when
+//   outputs: CALL and ASK (to the Negotiator), QUOTE (station, robot, wait: s until
+//            the station is the order's, makespan: s until the last step is done, robot_s: s
+//            the robot drives for it), PREPARE (resource_id: an arm or robot awarded, that
+//            commands will go to), RELEASE, COMMAND, CANCEL (fetches not delivered when
 //            the order fails), SIM (the topics' fields), STATUS (state, message, progress),
 //            FINDING (kind, message, part), PLACED (part: the bodies released in place,
 //            aside: the subassembly they were built into aside, "" in the product; the
@@ -58,6 +60,7 @@
 
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -66,6 +69,8 @@
 #include "services/node/gripper.hpp"
 #include "services/node/sim_requests.hpp"
 #include "services/runtime/basic_block.hpp"
+#include "twin/orchestration/assembly_script.hpp"
+#include "twin/orchestration/execution_model.hpp"
 #include "twin/planning/assembly_planner.hpp"
 #include "twin/report/timeline.hpp"
 
@@ -82,17 +87,8 @@ struct OrderSettings {
   double arm_speed = 0.25;          // m/s: virtual assembly's moves, until an arm's capability says
   double arm_angular_speed = 1.0;   // rad/s
   fb::GripperGeometry gripper;     // the cell's (deployment key `gripper:`), as the plan used it
-  // Taking up an order whose earlier twin ended during physical assembly, as the cell's
-  // state left it: the order books the station its parts stand on, and its steps done are
-  // not done again.
-  struct Resume {
-    int attempt = 1;                  // this twin's, for command ids of its own
-    std::string station;              // where its parts stand ("": nowhere)
-    std::set<std::string> placed;     // bodies assembled at their final poses
-    std::set<std::string> aside;      // bodies built into a subassembly that stands aside
-    std::set<std::string> delivered;  // bodies at the station's dock, not assembled yet
-    std::set<std::string> used;       // every body handed out before: a part set aside needs a new one
-  } resume;
+  // Taking up an order whose earlier twin ended during physical assembly (assembly_script.hpp).
+  Resume resume;
   // A resource it hired restarted under its work (services/node/restart_reason.hpp): end
   // this twin at once, releasing nothing, so that the next twin the cell starts takes the
   // order up from the cell's state. Off: the order fails.
@@ -100,6 +96,9 @@ struct OrderSettings {
   // Plan and assemble virtually, then ask for quotes instead of booking: no station, no
   // stock, nothing physical. The final status is the caller's (it prices the quote).
   bool quote_only = false;
+  // The cell's real-time factor as the twin last heard it: what the cell's messages cost in
+  // sim time (MessageCosts). Unset: nothing.
+  std::function<double()> real_time_factor;
 };
 
 class OrderOrchestrator : public fb::BasicBlock {
@@ -113,21 +112,14 @@ class OrderOrchestrator : public fb::BasicBlock {
   bool take_up() const { return take_up_; }
   // The commands sent for the order, with when each ran in sim time (its events'), in order.
   const Timeline& timeline() const { return timeline_; }
-  // Arm time of physical assembly: how long the order will hold a station, s of sim time.
-  double physical_estimate() const;
-  std::vector<double> arm_times() const;  // the same, per step
+  // How long physical assembly would hold `station` (and its arm), in s of sim time: the
+  // order's script at that station timed against its arm's model (execution_model.hpp), the
+  // parts at the dock; -1 while the station's place is not known. Bids to host the order are
+  // weighed by it (ModelledFinish, order_network.hpp): each station is offered the same call.
+  double hold_at(const std::string& station) const;
 
  private:
-  struct Action {
-    // send_heard: sent, and done once its resource has said anything of it. The robot takes
-    // fetches in the order it hears them, so the next goes only when the last was heard: a
-    // fetch resent after it was lost cannot be overtaken (deliveries out of the plan's order
-    // under load, 40 orders on four stations).
-    enum Kind { sim, command, send_heard, await_delivery } kind;
-    fb::Data data;
-    bool retry_on_collision = false;  // a move of a candidate trajectory in virtual assembly
-    bool may_fail = false;            // a removal of a body that may be gone already
-  };
+  using Action = ScriptAction;
   struct Place {
     std::string kind;
     fb::Numbers position, dock;
@@ -152,24 +144,14 @@ class OrderOrchestrator : public fb::BasicBlock {
   void on_quoted(const fb::Data& quote);
   void quote_when_arm_known();
   static double queue_of(const fb::Data& quoted);
-  std::vector<double> fetch_times() const;  // s per step: the robot's bid, shared by distance (0: it fetches nothing)
   fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
                      const std::string& station, const std::string& sources, long count, double duration) const;
   void start_physical_when_hired();
-  struct Carry {
-    std::vector<Pose> holding, retreat;
-    std::size_t turning = 0;  // the last this many of `holding` turn the part into a thread
-  };
   // Scripts.
   void add_candidate(std::size_t step, std::size_t candidate);
   void plan_physical();
   void plan_cleanup();
   void add_unit_candidate(std::size_t step, const Trajectory& t);
-  // `bodies`: the gripped one first, then those it carries; `aside`: the subassembly they are
-  // built into aside, "" when they go into the product; `hold`: connected before the release;
-  // `screw`, `into`: the helix at the end of the carry turns the part into that body's thread.
-  void add_arm_moves(const std::vector<std::string>& bodies, const Carry& carry, const std::string& aside, bool hold,
-                     const Screw* screw = nullptr, const std::string& into = "");
   fb::Data command(const std::string& resource, const std::string& operation, const std::string& part = "");
   // Running them.
   void next_action();
@@ -183,26 +165,13 @@ class OrderOrchestrator : public fb::BasicBlock {
   void finish();
   void status(const std::string& state, const std::string& message, double progress);
   std::vector<Trajectory> candidates(std::size_t step) const;
-  Pose at(const std::string& station, const Pose& pose) const;
-  fb::Numbers pose_numbers(const std::vector<Pose>& poses) const;
   std::string virtual_body(PartIndex part) const;
+  Location location(const std::string& resource) const;  // from its capability
+  Hired hired() const;
+  bool knows_places() const;  // of the station and the buffers: their capabilities were heard  // the station, arm, robot and buffers awarded, with their places
+  // The physical script for `h` timed against the resources' models (execution_model.hpp).
+  ModelledRun modelled(const Hired& h, double station_free, double robot_free) const;
   std::vector<std::string> virtual_gripper() const;  // its bodies in the order's scene, the palm first
-  std::string physical_body(PartIndex part) const;
-  // The subassembly that `step` builds aside or inserts; nullptr for a single part's step.
-  const SubassemblyPlan* subassembly_of(const PlanStep& step) const;
-  // Where the robot puts `part` down at the station's dock (in the cell; `start`: where its
-  // trajectory starts there).
-  Pose at_dock(const std::string& station, PartIndex part, const Pose& start) const;
-  // The gripper's poses at `station` for step `index`'s part gripped where it stands
-  // (`standing`) and carried along `t`: held (up, over what stands, down to the start, along
-  // it), then after the release (backing out). Virtual and physical assembly carry alike.
-  Carry carry(const std::string& station, std::size_t index, const Trajectory& t, const Pose& standing) const;
-  // The least height (product frame) at which the part of step `index`, at `pose` turned, and
-  // what it carries are carried over what stands: the parts its steps before put in the
-  // product, and every subassembly built aside; -inf when nothing stands.
-  double carry_height(std::size_t index, const Pose& pose) const;
-  // Where `part` stands in its subassembly built aside, in the product's frame.
-  Pose aside_pose(PartIndex part, const SubassemblyPlan& unit) const;
   std::map<std::string, int> parts_per_type() const;
   bool waited_too_long() const;
 
@@ -212,7 +181,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   fb::SimRequests sim_;
   std::map<std::string, Place> places_;  // what capabilities say, by resource id
   std::chrono::steady_clock::time_point waiting_since_;
-  std::deque<Action> actions_;
+  CarryGeometry geometry_{product_, plan_};
+  Script actions_;
   bool action_running_ = false;
   std::string awaited_id_;
   std::size_t command_count_ = 0;
@@ -228,7 +198,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   long ahead_ = -1;                               // in the station's queue, as last reported
   bool arm_held_ = false;
   bool robot_called_ = false;
-  double station_wait_ = 0, robot_wait_ = 0, robot_duration_ = 0;  // quotes: the best bids
+  double station_wait_ = 0, robot_wait_ = 0;  // quotes: the best bids' queues
+
   std::set<std::string> delivered_, spawned_;
   struct Sent {
     fb::Data command;

@@ -1,7 +1,6 @@
 #include "twin/orchestration/quote.hpp"
 
 #include <algorithm>
-#include <numeric>
 
 namespace twin {
 namespace {
@@ -13,27 +12,18 @@ double rate(const Rates& rates, const std::string& resource) {
 
 }  // namespace
 
-Quote estimate_quote(const QuoteBids& bids, const Rates& rates) {
+Quote price_quote(const QuoteTimes& times, const Rates& rates) {
   Quote q;
   q.feasible = true;
-  q.station = bids.station;
-  q.robot = bids.robot;
-  // From now: the station is the order's after its queue, the robot sets out once the station
-  // is the order's and its own earlier fetches are done.
-  const double start = std::max(0.0, bids.station_wait);
-  double delivered = std::max(start, bids.robot_wait);
-  double arm_done = start;
-  for (std::size_t i = 0; i < bids.arm.size(); ++i) {
-    if (i < bids.fetch.size()) delivered += bids.fetch[i];
-    arm_done = std::max(arm_done, delivered) + bids.arm[i];
-  }
-  q.wait_s = start;
-  q.makespan_s = arm_done;
-  q.station_s = arm_done - start;
-  q.robot_s = std::accumulate(bids.fetch.begin(), bids.fetch.end(), 0.0);
+  q.station = times.station;
+  q.robot = times.robot;
+  q.wait_s = times.wait;
+  q.makespan_s = times.makespan;
+  q.station_s = times.makespan - times.wait;
+  q.robot_s = times.robot_s;
   q.setup_cost = rates.setup_cost;
-  q.station_cost = q.station_s / 3600 * rate(rates, bids.station);
-  q.robot_cost = q.robot_s / 3600 * rate(rates, bids.robot);
+  q.station_cost = q.station_s / 3600 * rate(rates, times.station);
+  q.robot_cost = q.robot_s / 3600 * rate(rates, times.robot);
   q.total_cost = q.setup_cost + q.station_cost + q.robot_cost;
   q.currency = rates.currency;
   return q;

@@ -1,7 +1,7 @@
 #pragma once
-// A cell's answer to a request for a quote (docs/quotes.md): from the bids its resources
-// made (nothing awarded) and the times virtual assembly measured, when the product would be
-// done and what it would cost at the cell's rates.
+// A cell's answer to a request for a quote (docs/quotes.md): when the product would be done,
+// by the order's physical script run against the models of the resources that bid (nothing
+// awarded), and what it would cost at the cell's rates.
 
 #include <map>
 #include <string>
@@ -13,13 +13,13 @@
 
 namespace twin {
 
-// What the resources offered, in s of sim time (the physical cell's time).
-struct QuoteBids {
+// The order's physical assembly as the cell's model ran it (execution_model.hpp), in s of
+// sim time (the physical cell's time) from the moment of the quote.
+struct QuoteTimes {
   std::string station, robot;
-  double station_wait = 0;  // the station's bid: the orders in its queue, from now
-  double robot_wait = 0;    // the robot's bid: the fetches it has taken on, from now
-  std::vector<double> fetch;  // each step's fetch, in planned order (0: it fetches nothing)
-  std::vector<double> arm;    // the arm's time for each step: from the dock, in, back
+  double wait = 0;      // until the station is the order's (its queue)
+  double makespan = 0;  // until the last step is done
+  double robot_s = 0;   // the robot drives for the order
 };
 
 struct Rates {
@@ -40,10 +40,9 @@ struct Quote {
   std::string currency;
 };
 
-// The fetches and the arm as a two-stage flow: the robot starts once the station is the
-// order's (and the robot is free), brings the parts one after another; the arm inserts each
-// once it is delivered and the step before is done.
-Quote estimate_quote(const QuoteBids& bids, const Rates& rates);
+// The times, and their cost at the cell's rates: the order holds the station (with its arm)
+// from `wait` to `makespan`, the robot while it drives.
+Quote price_quote(const QuoteTimes& times, const Rates& rates);
 Quote infeasible_quote(const std::string& reason, const Rates& rates);
 
 // quote.json (schema agile-cell/quote): the quote, the plan's size and every finding.

@@ -322,6 +322,7 @@ class TwinProcess {
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
     settings.gripper = options_.gripper;
     settings.quote_only = options_.quote;
+    settings.real_time_factor = [this] { return clock_.real_time_factor(); };
     fb::NegotiationSettings negotiation;
     negotiation.wait = settings.wait_timeout;
     auto& orchestrator = twin::add_order_network(r, product, plan, settings, negotiation);
@@ -380,6 +381,7 @@ class TwinProcess {
         },
         dds::command_qos()));
     r.connect("orchestrator", "COMMAND", "commands", "REQ");
+    r.connect("orchestrator", "PREPARE", "commands", "PREPARE");
     publish<cell::CancelRequest, cell::CancelRequestPubSubType>(r, "cancels", "cell/cancel_requests", "orchestrator",
                                                                 "CANCEL", [this](const fb::Data& d) {
                                                                   cell::CancelRequest c;
@@ -408,10 +410,9 @@ class TwinProcess {
     r.connect("orchestrator", "FINDING", "findings", "REQ");
     std::optional<twin::Quote> quote;
     r.add(std::make_unique<fb::ActionBlock>("quote", [this, &quote](const fb::Data& d) {
-      twin::QuoteBids bids{fb::get<std::string>(d, "station"), fb::get<std::string>(d, "robot"),
-                           fb::get<double>(d, "station_wait"), fb::get<double>(d, "robot_wait"),
-                           fb::get<fb::Numbers>(d, "fetch"), fb::get<fb::Numbers>(d, "arm")};
-      quote = twin::estimate_quote(bids, options_.rates);
+      quote = twin::price_quote({fb::get<std::string>(d, "station"), fb::get<std::string>(d, "robot"),
+                                 fb::get<double>(d, "wait"), fb::get<double>(d, "makespan"), fb::get<double>(d, "robot_s")},
+                                options_.rates);
     }));
     r.connect("orchestrator", "QUOTE", "quote", "REQ");
     bool finished = false;
@@ -468,7 +469,7 @@ class TwinProcess {
   std::unique_ptr<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>> result_;
   std::vector<std::function<void()>> starters_;
   std::unique_ptr<state::CellStore> store_;  // the cell's durable state, if it keeps one
-  twin::OrderSettings::Resume resume_;
+  twin::Resume resume_;
   std::string stored_state_;
 };
 
