@@ -27,11 +27,13 @@ fastdds shm clean >/dev/null 2>&1 || true
 # The six longest process tests (many orders at once, chaos, security, the queue: 379 of the
 # 770 process-seconds of this phase's process tests) run in the Release and ThreadSanitizer phases; here
 # their code paths are covered by the shorter process tests, and the whole job stays well
-# under an hour on 2 cores (58 min with them, 2026-12-05).
+# under an hour on 2 cores (58 min with them, 2026-12-05). The quotes' accuracy is measured
+# against the cell's own speed: in the Release phase only (a sanitizer slows every message
+# tenfold, which a quote of a cell at 8x real time does not promise).
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" \
-  -E "^(chaos|secure cell|order desk|order queue|many orders):"
+  -E "^(chaos|secure cell|order desk|order queue|many orders|quotes come true):"
 
 cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_TSAN=ON -DCMAKE_CXX_COMPILER=clang++ \
   -DCELL_BUILD_BENCHMARKS=OFF
@@ -40,6 +42,6 @@ cmake --build build/tsan -j "$jobs" --target cellctl service_tests state_tests o
   two_host_tests
 fastdds shm clean >/dev/null 2>&1 || true
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
-  ctest --test-dir build/tsan --output-on-failure -j "$jobs" -L "blocks|dds|processes"
+  ctest --test-dir build/tsan --output-on-failure -j "$jobs" -L "blocks|dds|processes" -E "^quotes come true:"
 
 bash deploy/fuzz.sh 30 build/sanitize

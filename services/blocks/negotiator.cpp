@@ -99,13 +99,21 @@ void Negotiator::call(Call& c) {
   emit("CFP", c.data);
 }
 
+// Every resource heard that offers the operation answered, and the cell's roster has none of
+// a kind that offers it which this twin has not heard yet (a cell still coming up: a robot
+// whose capability is on its way may bid better; the bidding window waits for it).
 bool Negotiator::all_answered(const Call& c) const {
   const std::string& op = get<std::string>(c.data, "operation");
   bool any = false;
+  std::set<std::string> kinds;
   for (const auto& [resource, ops] : operations_) {
     if (!ops.count(op)) continue;
     any = true;
+    if (const auto kind = kinds_.find(resource); kind != kinds_.end()) kinds.insert(kind->second);
     if (!c.bids.count(resource) && !c.refusals.count(resource)) return false;
+  }
+  for (const auto& [resource, kind] : roster_) {
+    if (kinds.count(kind) && !operations_.count(resource) && !gone_.count(resource)) return false;
   }
   return any;
 }

@@ -377,3 +377,34 @@ TEST_CASE("contractor: what it took on is stored before it is confirmed, and a s
   CHECK(after.block().reserved_by() == "o2");
   CHECK(after.block().waiting().empty());
 }
+
+TEST_CASE("negotiator: a resource of the cell's roster not heard yet, of a kind that bids, is waited for until the window closes",
+          "[fb][negotiation]") {
+  // A cell coming up: robot-2 is in the roster but its capability has not come; robot-1 bids
+  // at once. The award waits for the window (robot-2 may bid better), then goes to the best.
+  fb::NegotiationSettings settings = quick();
+  settings.window = std::chrono::seconds(30);  // never out here, however slow the machine
+  fb::BlockTestFixture<fb::Negotiator> f("negotiator", "o1", settings);
+  f.send("ROSTER", {{"resources", std::string("robot-1\tmobile-robot\nrobot-2\tmobile-robot\nstation-1\tstation\n")}});
+  f.send("CAPABILITY", {{"resource_id", std::string("robot-1")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
+  f.send("CALL", cfp("o1", "fetch"));
+  CHECK(names<fb::Negotiator>(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9))).empty());
+  CHECK(names<fb::Negotiator>(f.send("TICK")).empty());  // within the window
+  // robot-2 comes and bids better: the call is all answered, and it wins.
+  f.send("CAPABILITY", {{"resource_id", std::string("robot-2")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
+  const auto out = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 0, 5));
+  REQUIRE(names<fb::Negotiator>(out) == Names{"AWARD"});
+  CHECK(fb::get<std::string>(out[0].data, "resource_id") == "robot-2");
+
+  // One that never comes holds a call up for the window only.
+  settings.window = std::chrono::milliseconds(40);
+  fb::BlockTestFixture<fb::Negotiator> g("negotiator", "o1", settings);
+  g.send("ROSTER", {{"resources", std::string("robot-1\tmobile-robot\nrobot-3\tmobile-robot\n")}});
+  g.send("CAPABILITY", {{"resource_id", std::string("robot-1")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
+  g.send("CALL", cfp("o1", "fetch"));
+  CHECK(names<fb::Negotiator>(g.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9))).empty());
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  const auto later = g.send("TICK");
+  REQUIRE(names<fb::Negotiator>(later) == Names{"AWARD"});
+  CHECK(fb::get<std::string>(later[0].data, "resource_id") == "robot-1");
+}
