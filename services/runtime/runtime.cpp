@@ -55,25 +55,6 @@ void FunctionBlock::post_to_self(const std::string& input, Data data) {
   resource_->post(name_, input, std::move(data));
 }
 
-// --- BasicBlock -----------------------------------------------------------------------------
-
-BasicBlock::BasicBlock(std::string name, std::string initial_state)
-    : FunctionBlock(std::move(name)), state_(std::move(initial_state)) {}
-
-void BasicBlock::transition(std::string from, std::string event, std::string to, Action action, Guard guard) {
-  transitions_.push_back({std::move(from), std::move(event), std::move(to), std::move(action), std::move(guard)});
-}
-
-void BasicBlock::receive(const Event& event) {
-  for (const auto& t : transitions_) {
-    if (t.from != state_ || t.event != event.name || (t.guard && !t.guard(event.data))) continue;
-    state_ = t.to;  // entered before the action, so that events the action emits see it
-    if (t.action) t.action(event.data);
-    return;
-  }
-  ++unhandled_;
-}
-
 // --- Resource -------------------------------------------------------------------------------
 
 Resource::Resource(std::string name, std::size_t queue_capacity) : name_(std::move(name)), capacity_(queue_capacity) {}

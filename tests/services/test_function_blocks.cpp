@@ -13,7 +13,7 @@ namespace {
 // Counts REQ events and answers each with CNF carrying the running count.
 class Counter : public fb::BasicBlock {
  public:
-  explicit Counter(std::string name) : BasicBlock(std::move(name), "READY") {
+  explicit Counter(std::string name) : fb::BasicBlock(std::move(name), "READY") {
     declare_input("REQ", {"step"});
     declare_output("CNF", {"count"});
     transition("READY", "REQ", "READY", [this](const fb::Data& d) {
@@ -22,6 +22,25 @@ class Counter : public fb::BasicBlock {
     }, [](const fb::Data& d) { return !d.count("step") || fb::get<std::int64_t>(d, "step") > 0; });
   }
   std::int64_t count = 0;
+};
+
+// A chart with enum states: GO starts a job; the action finds it done and raises DONE,
+// which the chart takes once the action is over, by a transition of its own.
+enum class Job { idle, working, done };
+class Worker : public fb::BasicChart<Job> {
+ public:
+  explicit Worker(std::string name) : BasicChart(std::move(name), Job::idle) {
+    declare_input("GO");
+    declare_output("STARTED");
+    declare_output("FINISHED");
+    transition(Job::idle, "GO", Job::working, [this](const fb::Data&) {
+      raise("DONE");
+      seen_in_action = state();  // not yet changed by what it raised
+      emit("STARTED");
+    });
+    transition(Job::working, "DONE", Job::done, [this](const fb::Data&) { emit("FINISHED"); });
+  }
+  Job seen_in_action = Job::idle;
 };
 
 using Names = std::vector<std::string>;
@@ -197,4 +216,15 @@ TEST_CASE("command life cycle: a cancel counts only from the command's own order
   CHECK(cancel("c1", "o1") == Names{"CANCELING", "STOP"});
   CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
   CHECK(cancel("c1", "o1").empty());  // ended: nothing to cancel
+}
+
+TEST_CASE("a chart's internal event is taken by a transition once the action that raised it is over", "[fb]") {
+  fb::BlockTestFixture<Worker> f("worker");
+  const auto out = f.send("GO");
+  CHECK(names<Worker>(out) == Names{"STARTED", "FINISHED"});
+  CHECK(f.block().seen_in_action == Job::working);
+  CHECK(f.block().state() == Job::done);
+  CHECK(f.block().unhandled_events() == 0);
+  f.send("GO");  // no transition from done
+  CHECK(f.block().unhandled_events() == 1);
 }

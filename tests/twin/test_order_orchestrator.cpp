@@ -411,7 +411,7 @@ TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, w
   CHECK_FALSE(out.complete);
   CHECK(out.error.find("no collision-free path in cell-sim for hanging") != std::string::npos);
   CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") == out.order.end());  // never booked a station
-  CHECK(t.orchestrator->state() == "ENDED");
+  CHECK(t.orchestrator->state() == twin::Phase::ended);
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {

@@ -23,7 +23,7 @@ const std::string kHost = "host", kArm = "arm", kRobot = "robot", kGive = "give/
 
 OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& product, const Plan& plan,
                                      OrderSettings settings)
-    : BasicBlock(std::move(name), "IDLE"), product_(product), plan_(plan),
+    : BasicChart(std::move(name), Phase::idle), product_(product), plan_(plan),
       settings_(std::move(settings)), sim_(settings_.order_id) {
   declare_input("START");
   declare_input("TICK");
@@ -37,7 +37,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_input("SIM_REPLY", {"request_id", "ok", "error", "collided"});
   declare_output("CALL", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
   declare_output("ASK", {"call_id", "operation", "part_type", "station", "sources", "count", "duration"});
-  declare_output("QUOTE", {"station", "station_wait", "robot", "robot_wait", "fetch", "arm"});
+  declare_output("QUOTE", {"station", "robot", "wait", "makespan", "robot_s"});
   for (const char* out : {"RELEASE", "COMMAND", "CANCEL", "SIM"}) declare_output(out);
   declare_output("PREPARE", {"resource_id"});
   declare_output("STATUS", {"state", "message", "progress"});
@@ -45,8 +45,9 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   declare_output("PLACED", {"part", "aside"});
   declare_output("FINISHED", {"complete", "error", "take_up"});
 
-  const char* all_states[] = {"IDLE",   "WAITING_CELL", "VIRTUAL", "BOOKING", "QUEUED",
-                              "HIRING", "PHYSICAL",     "QUOTING", "CLEANUP", "ENDED"};
+  const Phase all_states[] = {Phase::idle,   Phase::waiting_cell, Phase::virtual_assembly, Phase::booking,
+                              Phase::queued, Phase::hiring,       Phase::physical,         Phase::quoting,
+                              Phase::cleanup, Phase::ended};
   // What the cell's resources say of themselves, in every state; a place that is no place
   // (a position that is not finite) is not taken.
   const auto is_place = [](const Data& d) {
@@ -54,7 +55,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     check.vector("position").vector("dock").at_least("speed", 0).at_least("angular_speed", 0);
     return check.ok();
   };
-  for (const char* in : all_states) {
+  for (const Phase in : all_states) {
     transition(in, "CAPABILITY", in, [this, is_place](const Data& d) {
       if (!is_place(d)) return;
       Place& p = places_[get<std::string>(d, "resource_id")];
@@ -62,38 +63,39 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
            get<double>(d, "angular_speed"), get<std::string>(d, "reserved_by"),
            fb::split_names(get<std::string>(d, "waiting"))};
       const std::string& id = get<std::string>(d, "resource_id");
-      if (state() == "WAITING_CELL") try_begin_virtual();
-      if (state() == "QUEUED" && id == station_) on_queue_news(p);
-      if (state() == "QUEUED" && p.kind == "station" && id != station_) consider_moving_to(id);
-      if (state() == "HIRING" && id == arm_ && p.reserved_by == settings_.order_id) arm_held_ = true;
-      if (state() == "HIRING") start_physical_when_hired();
-      if (state() == "QUOTING") quote_when_arm_known();
+      if (state() == Phase::waiting_cell) try_begin_virtual();
+      if (state() == Phase::queued && id == station_) on_queue_news(p);
+      if (state() == Phase::queued && p.kind == "station" && id != station_) consider_moving_to(id);
+      if (state() == Phase::hiring && id == arm_ && p.reserved_by == settings_.order_id) arm_held_ = true;
+      if (state() == Phase::hiring) start_physical_when_hired();
+      if (state() == Phase::quoting) quote_when_arm_known();
     });
   }
 
   // cell-sim is pinged until it answers: then requests and replies both get through.
-  transition("IDLE", "START", "WAITING_CELL", [this](const Data&) {
+  transition(Phase::idle, "START", Phase::waiting_cell, [this](const Data&) {
     waiting_since_ = std::chrono::steady_clock::now();
     status("PLANNING", "planned " + std::to_string(plan_.steps.size()) + " steps; waiting for a station of the cell", 0);
     emit("SIM", sim_.ping());
   });
-  transition("WAITING_CELL", "SIM_REPLY", "WAITING_CELL", [this](const Data&) {
+  transition(Phase::waiting_cell, "SIM_REPLY", Phase::waiting_cell, [this](const Data&) {
     sim_answers_ = true;
     try_begin_virtual();
   });
-  transition("WAITING_CELL", "TICK", "WAITING_CELL", [this](const Data&) {
+  transition(Phase::waiting_cell, "TICK", Phase::waiting_cell, [this](const Data&) {
     if (waited_too_long()) {
       return fail(std::string(sim_answers_ ? "no station of the cell appeared" : "cell-sim did not answer") +
                   " within " + std::to_string(settings_.wait_timeout.count() / 1000) + " s: is the cell up?");
     }
     if (!sim_answers_) emit("SIM", sim_.ping());
   });
+  transition(Phase::waiting_cell, "CELL_READY", Phase::virtual_assembly, [this](const Data&) { begin_virtual(); });
 
   // Cell-sim's answers, in the states that send it requests.
-  for (const char* in : {"VIRTUAL", "PHYSICAL", "CLEANUP"}) {
+  for (const Phase in : {Phase::virtual_assembly, Phase::physical, Phase::cleanup}) {
     transition(in, "SIM_REPLY", in, [this](const Data& d) {
       if (!action_running_ || get<std::string>(d, "request_id") != awaited_id_) return;
-      if (state() == "CLEANUP") return action_done();
+      if (state() == Phase::cleanup) return action_done();
       if (!get<bool>(d, "ok") && actions_.front().may_fail) return action_done();
       if (!get<bool>(d, "ok")) return fail("cell-sim refused: " + get<std::string>(d, "error"));
       if (fb::get_or<bool>(d, "collided", false) && actions_.front().retry_on_collision) {
@@ -106,21 +108,37 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   }
 
   // Booking a station, then hiring what physical assembly needs there.
-  for (const char* in : {"BOOKING", "QUEUED", "HIRING", "QUOTING"}) {
+  transition(Phase::virtual_assembly, "VIRTUAL_DONE", Phase::quoting, [this](const Data&) { ask_for_quotes(); },
+             [this](const Data&) { return settings_.quote_only; });
+  transition(Phase::virtual_assembly, "VIRTUAL_DONE", Phase::booking, [this](const Data&) { book(); });
+  for (const Phase in : {Phase::booking, Phase::queued, Phase::hiring, Phase::quoting}) {
     transition(in, "UNAVAILABLE", in, [this](const Data& d) { fail(get<std::string>(d, "reason")); });
   }
-  for (const char* in : {"BOOKING", "QUEUED", "HIRING"}) {
+  for (const Phase in : {Phase::booking, Phase::queued, Phase::hiring}) {
     transition(in, "AWARDED", in, [this](const Data& d) { on_awarded(d); });
   }
-  transition("QUOTING", "QUOTED", "QUOTING", [this](const Data& d) { on_quoted(d); });
-  transition("QUOTING", "TICK", "QUOTING", [this](const Data&) {
+  for (const Phase in : {Phase::booking, Phase::queued}) {
+    transition(in, "WAITS", Phase::queued, [this](const Data& d) {
+      on_queue_news(places_[station_]);
+      if (ahead_ < 0) report_place(get<std::int64_t>(d, "ahead"));
+    });
+    transition(in, "STATION_OURS", Phase::hiring, [this](const Data&) { hire(); });
+  }
+  transition(Phase::queued, "REBOOK", Phase::booking, [this](const Data& d) { book(get<std::string>(d, "only")); });
+  transition(Phase::hiring, "HIRED", Phase::physical, [this](const Data&) { plan_physical(); });
+  transition(Phase::quoting, "QUOTED", Phase::quoting, [this](const Data& d) { on_quoted(d); });
+  transition(Phase::quoting, "TICK", Phase::quoting, [this](const Data&) {
     if (!robot_.empty() && waited_too_long()) fail("the arm of " + station_ + " did not say its speed (no capability heard)");
   });
-  for (const char* in : all_states) {
+  transition(Phase::quoting, "PRICED", Phase::ended, [this](const Data& quote) {
+    emit("QUOTE", quote);
+    emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
+  });
+  for (const Phase in : all_states) {
     transition(in, "RESOURCE_GONE", in, [this](const Data& d) { on_resource_gone(get<std::string>(d, "resource_id")); });
   }
 
-  transition("PHYSICAL", "COMMAND_EVENT", "PHYSICAL", [this](const Data& d) {
+  transition(Phase::physical, "COMMAND_EVENT", Phase::physical, [this](const Data& d) {
     if (get<std::string>(d, "order_id") != settings_.order_id) return;
     const std::string& id = get<std::string>(d, "command_id");
     unheard_.erase(id);
@@ -142,7 +160,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     fail(fb::get_or<std::string>(d, "resource_id", "") + " " + get<std::string>(actions_.front().data, "operation") +
          " failed: " + get<std::string>(d, "reason"));
   });
-  transition("CLEANUP", "COMMAND_EVENT", "CLEANUP", [this](const Data& d) {
+  transition(Phase::cleanup, "COMMAND_EVENT", Phase::cleanup, [this](const Data& d) {
     unheard_.erase(get<std::string>(d, "command_id"));
     record(d);
     if (action_running_ && get<std::string>(d, "command_id") == awaited_id_ &&
@@ -150,10 +168,22 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       action_done();
     }
   });
-  transition("PHYSICAL", "TICK", "PHYSICAL", [this](const Data&) { resend_unheard(); });
-  transition("CLEANUP", "TICK", "CLEANUP", [this](const Data&) {
-    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) finish();
+  transition(Phase::physical, "TICK", Phase::physical, [this](const Data&) { resend_unheard(); });
+  transition(Phase::physical, "PHYSICAL_DONE", Phase::cleanup, [this](const Data&) { plan_cleanup(); });
+
+  // A failure anywhere cancels undelivered fetches (fail) and cleans up; the order's twin
+  // ends at once to be taken up again (take_up_after_restart).
+  for (const Phase in : {Phase::waiting_cell, Phase::virtual_assembly, Phase::booking, Phase::queued, Phase::hiring,
+                         Phase::physical, Phase::quoting}) {
+    transition(in, "FAILED", Phase::cleanup, [this](const Data&) { plan_cleanup(); });
+  }
+  transition(Phase::physical, "TAKE_UP", Phase::ended, [this](const Data&) {
+    emit("FINISHED", {{"complete", false}, {"error", error_}, {"take_up", true}});
   });
+  transition(Phase::cleanup, "TICK", Phase::cleanup, [this](const Data&) {
+    if (std::chrono::steady_clock::now() - waiting_since_ > settings_.cleanup_timeout) raise("CLEANED");
+  });
+  transition(Phase::cleanup, "CLEANED", Phase::ended, [this](const Data&) { finish(); });
 }
 
 // --- booking and hiring --------------------------------------------------------------------
@@ -172,11 +202,13 @@ void OrderOrchestrator::try_begin_virtual() {
     }
     if (p.kind == "station" && virtual_station_.empty()) virtual_station_ = id;
   }
-  if (virtual_station_.empty() || !sim_answers_) return;
-  enter("VIRTUAL");
+  if (!virtual_station_.empty() && sim_answers_) raise("CELL_READY");
+}
+
+void OrderOrchestrator::begin_virtual() {
   status("VIRTUAL_ASSEMBLY", "virtual assembly in cell-sim", 0);
   step_ = candidate_ = 0;
-  if (plan_.steps.empty()) return settings_.quote_only ? ask_for_quotes() : book();
+  if (plan_.steps.empty()) return raise("VIRTUAL_DONE");
   if (settings_.resume.attempt > 1) {
     // An earlier twin of the order may have died in the middle of it: its virtual bodies
     // are still in the order's scene (cell-sim keeps them for the order), in the way.
@@ -244,7 +276,6 @@ Data OrderOrchestrator::call_data(const std::string& what, const std::string& op
 
 void OrderOrchestrator::book(std::string only) {
   if (only.empty()) only = settings_.resume.station;  // its parts stand there
-  enter("BOOKING");
   ahead_ = -1;
   waiting_since_ = std::chrono::steady_clock::now();
   const std::string why = only == settings_.resume.station ? ", where its parts stand" : ", whose queue is shorter";
@@ -265,30 +296,30 @@ void OrderOrchestrator::consider_moving_to(const std::string& station) {
   if (ahead_ < 1 || !(load == 0 || load + 1 < ahead_)) return;
   emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", station_}});
   awarded_.erase(station_);
-  book(station);
+  raise("REBOOK", {{"only", station}});
 }
 
 void OrderOrchestrator::on_resource_gone(const std::string& id) {
   places_.erase(id);
-  if (state() == "QUOTING" && (id == station_ || id == robot_ || std::any_of(buffer_of_.begin(), buffer_of_.end(), [&id](const auto& b) {
+  if (state() == Phase::quoting && (id == station_ || id == robot_ || std::any_of(buffer_of_.begin(), buffer_of_.end(), [&id](const auto& b) {
                                  return b.second == id;
                                }))) {
     return fail(id + " disappeared while the order asked for quotes");
   }
-  if (state() == "QUEUED" && id == station_) {
+  if (state() == Phase::queued && id == station_) {
     awarded_.erase(station_);
     emit("FINDING", {{"kind", std::string("rebooked")},
                      {"message", station_ + " disappeared while the order waited for it; booking another station"},
                      {"part", std::string()}});
-    return book();
+    return raise("REBOOK", {{"only", std::string()}});
   }
-  if ((state() == "HIRING" || state() == "PHYSICAL") && awarded_.count(id)) {
+  if ((state() == Phase::hiring || state() == Phase::physical) && awarded_.count(id)) {
     fail(id + " disappeared (its liveliness lease ran out)");
   }
 }
 
 void OrderOrchestrator::on_queue_news(const Place& station) {
-  if (station.reserved_by == settings_.order_id) return hire();
+  if (station.reserved_by == settings_.order_id) return raise("STATION_OURS");
   const auto it = std::find(station.waiting.begin(), station.waiting.end(), settings_.order_id);
   if (it == station.waiting.end()) return;  // not in the queue yet (the award's reply was quicker)
   report_place(1 + (it - station.waiting.begin()));
@@ -310,7 +341,6 @@ std::map<std::string, int> OrderOrchestrator::parts_per_type() const {
 }
 
 void OrderOrchestrator::hire() {
-  enter("HIRING");
   status("WAITING", station_ + " is ours; hiring its arm, a mobile robot and buffers", 0);
   emit("CALL", call_data(kArm, "translate", "", station_, "", 0, hold_at(station_)));
   for (const auto& [type, count] : parts_per_type()) emit("CALL", call_data(kGive + type, "give", type, station_, "", count, 0));
@@ -325,11 +355,8 @@ void OrderOrchestrator::on_awarded(const Data& d) {
   const long ahead = static_cast<long>(get<std::int64_t>(d, "ahead"));
   if (what == kHost) {
     station_ = resource;
-    if (ahead == 0) return hire();
-    enter("QUEUED");
-    on_queue_news(places_[station_]);
-    if (ahead_ < 0) report_place(ahead);
-    return;
+    if (ahead == 0) return raise("STATION_OURS");
+    return raise("WAITS", {{"ahead", std::int64_t(ahead)}});
   }
   // Its commands' writer is made now: matched by the first command.
   if (what == kArm || what == kRobot) emit("PREPARE", {{"resource_id", resource}});
@@ -359,7 +386,6 @@ void OrderOrchestrator::call_robot_when_ready(const char* how) {
 // --- quotes --------------------------------------------------------------------------------
 
 void OrderOrchestrator::ask_for_quotes() {
-  enter("QUOTING");
   waiting_since_ = std::chrono::steady_clock::now();
   status("WAITING", "virtual assembly done; asking the cell's resources for quotes", 0);
   emit("ASK", call_data(kHost, kHost, "", "", "", 0, std::max(0.0, hold_at(virtual_station_))));
@@ -394,18 +420,14 @@ void OrderOrchestrator::on_quoted(const Data& d) {
 void OrderOrchestrator::quote_when_arm_known() {
   if (robot_.empty() || !arm_at(station_) || !knows_places()) return;
   const ModelledRun run = modelled(hired(), station_wait_, robot_wait_);
-  emit("QUOTE", {{"station", station_}, {"robot", robot_}, {"wait", run.start}, {"makespan", run.end},
-                 {"robot_s", run.robot_s}});
-  enter("ENDED");
-  emit("FINISHED", {{"complete", true}, {"error", std::string()}, {"take_up", false}});
+  raise("PRICED", {{"station", station_}, {"robot", robot_}, {"wait", run.start}, {"makespan", run.end},
+                   {"robot_s", run.robot_s}});
 }
 
 // Also once the places of the station and the buffers are known: a resource's proposal may
 // come before its capability (DDS matches each pair of endpoints on its own).
 void OrderOrchestrator::start_physical_when_hired() {
-  if (state() != "HIRING" || robot_.empty() || arm_.empty() || !arm_held_ || !knows_places()) return;
-  enter("PHYSICAL");
-  plan_physical();
+  if (state() == Phase::hiring && !robot_.empty() && !arm_.empty() && arm_held_ && knows_places()) raise("HIRED");
 }
 
 bool OrderOrchestrator::knows_places() const {
@@ -640,7 +662,6 @@ void OrderOrchestrator::plan_physical() {
 }
 
 void OrderOrchestrator::plan_cleanup() {
-  enter("CLEANUP");
   waiting_since_ = std::chrono::steady_clock::now();
   unheard_.clear();  // what was not heard of by now is not wanted any more
   actions_.clear();
@@ -676,7 +697,7 @@ void OrderOrchestrator::next_action() {
     }
   }
   action_running_ = false;
-  if (state() == "VIRTUAL") {
+  if (state() == Phase::virtual_assembly) {
     if (step_ < plan_.steps.size()) {
       plan_.steps[step_].trajectory = candidates(step_)[candidate_];
       status("VIRTUAL_ASSEMBLY", "virtual assembly: " + std::to_string(step_ + 1) + " of " +
@@ -692,20 +713,20 @@ void OrderOrchestrator::next_action() {
       spawned_.clear();
       if (!actions_.empty()) return next_action();
     }
-    return settings_.quote_only ? ask_for_quotes() : book();
+    return raise("VIRTUAL_DONE");
   }
-  if (state() == "PHYSICAL") {
+  if (state() == Phase::physical) {
     status("PHYSICAL_ASSEMBLY", "physical assembly done", 1);
-    return plan_cleanup();
+    return raise("PHYSICAL_DONE");
   }
-  finish();
+  raise("CLEANED");
 }
 
 void OrderOrchestrator::action_done() {
   const Action& a = actions_.front();
   // Released, the part stands in the product (the arm recorded it so with the release).
   const auto placed = a.kind == Action::command ? placed_by_.find(get<std::string>(a.data, "command_id")) : placed_by_.end();
-  if (state() == "PHYSICAL" && placed != placed_by_.end()) {
+  if (state() == Phase::physical && placed != placed_by_.end()) {
     emit("PLACED", placed->second);
     placed_by_.erase(placed);
     const std::size_t left = placed_by_.size();
@@ -755,20 +776,18 @@ void OrderOrchestrator::resend_unheard() {
 void OrderOrchestrator::fail(const std::string& reason) {
   if (!error_.empty()) return;
   error_ = reason;
-  if (settings_.take_up_after_restart && state() == "PHYSICAL" && fb::says_restarted(reason)) {
+  if (settings_.take_up_after_restart && state() == Phase::physical && fb::says_restarted(reason)) {
     take_up_ = true;
-    enter("ENDED");
-    return emit("FINISHED", {{"complete", false}, {"error", error_}, {"take_up", true}});
+    return raise("TAKE_UP");
   }
   // The mobile robot need not fetch what will not be assembled.
   for (const auto& [fetch, part] : fetch_of_) {
     if (!delivered_.count(fetch)) emit("CANCEL", {{"command_id", fetch}});
   }
-  plan_cleanup();
+  raise("FAILED");
 }
 
 void OrderOrchestrator::finish() {
-  enter("ENDED");
   for (const std::string& resource : awarded_) {
     emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", resource}});
   }

@@ -39,6 +39,19 @@
 //                call nobody bids on fails the order with every refusal's reason.
 // A failure anywhere cancels undelivered fetches and goes through CLEANUP to ENDED.
 //
+// Every change of state is a transition of the chart (its states: Phase). Where an action
+// finds the way on, it raises an internal event, which the chart takes next:
+//   WAITING_CELL  -CELL_READY->     VIRTUAL    cell-sim answered and a station is known
+//   VIRTUAL       -VIRTUAL_DONE->   BOOKING, or QUOTING for a quote
+//   BOOKING       -WAITS (ahead)->  QUEUED     the station confirmed a place in its queue
+//   BOOKING, QUEUED -STATION_OURS-> HIRING
+//   QUEUED        -REBOOK (only)->  BOOKING    a shorter queue elsewhere, or its station gone
+//   HIRING        -HIRED->          PHYSICAL   arm held, robot and buffers awarded, places known
+//   QUOTING       -PRICED->         ENDED      the quote (QUOTE), FINISHED
+//   PHYSICAL      -PHYSICAL_DONE->  CLEANUP
+//   any but CLEANUP and ENDED -FAILED-> CLEANUP;  PHYSICAL -TAKE_UP-> ENDED (FINISHED, take_up)
+//   CLEANUP       -CLEANED->        ENDED      the bodies removed, or the cleanup's time out
+//
 // No hold-and-wait: while it waits for a station the order holds nothing; once it holds a
 // station, everything else it needs is shared (robots, buffers) or belongs to that station
 // (its arm), so every wait is bounded.
@@ -101,7 +114,9 @@ struct OrderSettings {
   std::function<double()> real_time_factor;
 };
 
-class OrderOrchestrator : public fb::BasicBlock {
+enum class Phase { idle, waiting_cell, virtual_assembly, booking, queued, hiring, physical, quoting, cleanup, ended };
+
+class OrderOrchestrator : public fb::BasicChart<Phase> {
  public:
   OrderOrchestrator(std::string name, const LoadedProduct& product, const Plan& plan, OrderSettings settings);
 
@@ -129,7 +144,8 @@ class OrderOrchestrator : public fb::BasicBlock {
   };
 
   // Booking and hiring.
-  void try_begin_virtual();
+  void try_begin_virtual();  // CELL_READY once cell-sim answered and a station is known
+  void begin_virtual();
   void book(std::string only = "");  // `only`: call that station alone
   void on_queue_news(const Place& station);
   void report_place(long ahead);  // "waiting for station-1: N orders ahead", when N changed
