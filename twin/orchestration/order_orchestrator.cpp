@@ -1,13 +1,10 @@
 #include "twin/orchestration/order_orchestrator.hpp"
 
-#include "services/node/restart_reason.hpp"
-
 #include <algorithm>
-#include <cmath>
 #include <limits>
-#include <numeric>
 
 #include "services/blocks/sample_checks.hpp"
+#include "services/node/restart_reason.hpp"
 #include "twin/planning/subassembly_planner.hpp"
 
 namespace twin {
@@ -17,14 +14,12 @@ using fb::Data;
 using fb::get;
 using fb::Numbers;
 
-const std::string kHost = "host", kArm = "arm", kRobot = "robot", kGive = "give/";
-
 }  // namespace
 
 OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& product, const Plan& plan,
                                      OrderSettings settings)
     : BasicChart(std::move(name), Phase::idle), product_(product), plan_(plan),
-      settings_(std::move(settings)), sim_(settings_.order_id) {
+      settings_(std::move(settings)), sim_(settings_.order_id), booking_(settings_.order_id) {
   declare_input("START");
   declare_input("TICK");
   declare_input("CAPABILITY", {"resource_id", "kind", "position", "dock", "speed", "angular_speed", "reserved_by",
@@ -64,9 +59,9 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
            fb::split_names(get<std::string>(d, "waiting"))};
       const std::string& id = get<std::string>(d, "resource_id");
       if (state() == Phase::waiting_cell) try_begin_virtual();
-      if (state() == Phase::queued && id == station_) on_queue_news(p);
-      if (state() == Phase::queued && p.kind == "station" && id != station_) consider_moving_to(id);
-      if (state() == Phase::hiring && id == arm_ && p.reserved_by == settings_.order_id) arm_held_ = true;
+      if (state() == Phase::queued && id == booking_.station()) on_queue_news(p);
+      if (state() == Phase::queued && p.kind == "station" && id != booking_.station()) consider_moving_to(id);
+      if (state() == Phase::hiring && id == booking_.arm_resource() && p.reserved_by == settings_.order_id) arm_held_ = true;
       if (state() == Phase::hiring) start_physical_when_hired();
       if (state() == Phase::quoting) quote_when_arm_known();
     });
@@ -119,7 +114,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   }
   for (const Phase in : {Phase::booking, Phase::queued}) {
     transition(in, "WAITS", Phase::queued, [this](const Data& d) {
-      on_queue_news(places_[station_]);
+      on_queue_news(places_[booking_.station()]);
       if (ahead_ < 0) report_place(get<std::int64_t>(d, "ahead"));
     });
     transition(in, "STATION_OURS", Phase::hiring, [this](const Data&) { hire(); });
@@ -128,7 +123,9 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   transition(Phase::hiring, "HIRED", Phase::physical, [this](const Data&) { plan_physical(); });
   transition(Phase::quoting, "QUOTED", Phase::quoting, [this](const Data& d) { on_quoted(d); });
   transition(Phase::quoting, "TICK", Phase::quoting, [this](const Data&) {
-    if (!robot_.empty() && waited_too_long()) fail("the arm of " + station_ + " did not say its speed (no capability heard)");
+    if (!booking_.robot().empty() && waited_too_long()) {
+      fail("the arm of " + booking_.station() + " did not say its speed (no capability heard)");
+    }
   });
   transition(Phase::quoting, "PRICED", Phase::ended, [this](const Data& quote) {
     emit("QUOTE", quote);
@@ -262,16 +259,9 @@ double OrderOrchestrator::hold_at(const std::string& station) const {
   // Every part at the dock already: what the arm does there.
   Hired h{settings_.order_id, station, "arm", "", {}, {}};
   h.places[station] = location(station);
-  for (const auto& [type, count] : parts_per_type()) h.buffer_of[type] = station;
+  for (const auto& type : fetched_types()) h.buffer_of[type] = station;
   const ModelledRun run = modelled(h, 0, 0);
   return run.end - run.start;
-}
-
-Data OrderOrchestrator::call_data(const std::string& what, const std::string& operation, const std::string& type,
-                                  const std::string& station, const std::string& sources, long count,
-                                  double duration) const {
-  return {{"call_id", settings_.order_id + "/" + what}, {"operation", operation}, {"part_type", type},
-          {"station", station}, {"sources", sources}, {"count", std::int64_t(count)}, {"duration", duration}};
 }
 
 void OrderOrchestrator::book(std::string only) {
@@ -280,7 +270,7 @@ void OrderOrchestrator::book(std::string only) {
   waiting_since_ = std::chrono::steady_clock::now();
   const std::string why = only == settings_.resume.station ? ", where its parts stand" : ", whose queue is shorter";
   status("WAITING", only.empty() ? "virtual assembly done; booking a station" : "booking " + only + why, 0);
-  emit("CALL", call_data(kHost, kHost, "", only, "", 0, std::max(0.0, hold_at(only.empty() ? virtual_station_ : only))));
+  emit("CALL", booking_.host(only, std::max(0.0, hold_at(only.empty() ? virtual_station_ : only))));
 }
 
 // Orders booked at the same moment see the same bids and may crowd one station: an order
@@ -294,26 +284,26 @@ void OrderOrchestrator::consider_moving_to(const std::string& station) {
                         ? 0
                         : (p.reserved_by.empty() ? 0 : 1) + static_cast<long>(p.waiting.size());
   if (ahead_ < 1 || !(load == 0 || load + 1 < ahead_)) return;
-  emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", station_}});
-  awarded_.erase(station_);
+  emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", booking_.station()}});
+  booking_.leave_station();
   raise("REBOOK", {{"only", station}});
 }
 
 void OrderOrchestrator::on_resource_gone(const std::string& id) {
   places_.erase(id);
-  if (state() == Phase::quoting && (id == station_ || id == robot_ || std::any_of(buffer_of_.begin(), buffer_of_.end(), [&id](const auto& b) {
-                                 return b.second == id;
-                               }))) {
+  const auto& buffers = booking_.buffer_of();
+  if (state() == Phase::quoting && (id == booking_.station() || id == booking_.robot() ||
+                                    std::any_of(buffers.begin(), buffers.end(), [&id](const auto& b) { return b.second == id; }))) {
     return fail(id + " disappeared while the order asked for quotes");
   }
-  if (state() == Phase::queued && id == station_) {
-    awarded_.erase(station_);
+  if (state() == Phase::queued && id == booking_.station()) {
+    booking_.leave_station();
     emit("FINDING", {{"kind", std::string("rebooked")},
-                     {"message", station_ + " disappeared while the order waited for it; booking another station"},
+                     {"message", id + " disappeared while the order waited for it; booking another station"},
                      {"part", std::string()}});
     return raise("REBOOK", {{"only", std::string()}});
   }
-  if ((state() == Phase::hiring || state() == Phase::physical) && awarded_.count(id)) {
+  if ((state() == Phase::hiring || state() == Phase::physical) && booking_.holds(id)) {
     fail(id + " disappeared (its liveliness lease ran out)");
   }
 }
@@ -328,59 +318,37 @@ void OrderOrchestrator::on_queue_news(const Place& station) {
 void OrderOrchestrator::report_place(long ahead) {
   if (ahead == ahead_) return;
   ahead_ = ahead;
-  status("WAITING", "waiting for " + station_ + ": " + std::to_string(ahead) + (ahead == 1 ? " order" : " orders") +
+  status("WAITING", "waiting for " + booking_.station() + ": " + std::to_string(ahead) + (ahead == 1 ? " order" : " orders") +
                         " ahead", 0);
 }
 
-std::map<std::string, int> OrderOrchestrator::parts_per_type() const {
-  std::map<std::string, int> out;
-  for (const auto& step : plan_.steps) {
-    if (!inserts_unit(step)) ++out[short_type_name(product_.product.parts()[step.part].type)];
-  }
-  return out;
-}
-
 void OrderOrchestrator::hire() {
-  status("WAITING", station_ + " is ours; hiring its arm, a mobile robot and buffers", 0);
-  emit("CALL", call_data(kArm, "translate", "", station_, "", 0, hold_at(station_)));
-  for (const auto& [type, count] : parts_per_type()) emit("CALL", call_data(kGive + type, "give", type, station_, "", count, 0));
-  call_robot_when_ready("CALL");
+  status("WAITING", booking_.station() + " is ours; hiring its arm, a mobile robot and buffers", 0);
+  emit("CALL", booking_.arm(hold_at(booking_.station())));
+  for (const Data& give : booking_.gives(fetched_types())) emit("CALL", give);
+  if (const auto robot = booking_.robot_when_ready(fetched_types())) emit("CALL", *robot);
 }
 
 void OrderOrchestrator::on_awarded(const Data& d) {
-  const std::string what = get<std::string>(d, "call_id").substr(settings_.order_id.size() + 1);
+  const Booking::For what = booking_.awarded(d);
   const std::string& resource = get<std::string>(d, "resource_id");
-  awarded_.insert(resource);
-  award_of_[resource] = get<std::string>(d, "call_id");
   const long ahead = static_cast<long>(get<std::int64_t>(d, "ahead"));
-  if (what == kHost) {
-    station_ = resource;
-    if (ahead == 0) return raise("STATION_OURS");
-    return raise("WAITS", {{"ahead", std::int64_t(ahead)}});
-  }
-  // Its commands' writer is made now: matched by the first command.
-  if (what == kArm || what == kRobot) emit("PREPARE", {{"resource_id", resource}});
-  if (what == kArm) {
-    arm_ = resource;
-    arm_held_ = ahead == 0 || places_[arm_].reserved_by == settings_.order_id;
-  } else if (what == kRobot) {
-    robot_ = resource;
-  } else if (what.rfind(kGive, 0) == 0) {
-    buffer_of_[what.substr(kGive.size())] = resource;
-    call_robot_when_ready("CALL");
+  switch (what) {
+    case Booking::For::host:
+      if (ahead == 0) return raise("STATION_OURS");
+      return raise("WAITS", {{"ahead", std::int64_t(ahead)}});
+    case Booking::For::arm:
+      emit("PREPARE", {{"resource_id", resource}});  // its commands' writer, matched by the first command
+      arm_held_ = ahead == 0 || places_[resource].reserved_by == settings_.order_id;
+      break;
+    case Booking::For::robot:
+      emit("PREPARE", {{"resource_id", resource}});
+      break;
+    case Booking::For::give:
+      if (const auto robot = booking_.robot_when_ready(fetched_types())) emit("CALL", *robot);
+      break;
   }
   start_physical_when_hired();
-}
-
-// The robot's bid depends on where it fetches from: it is called once every buffer is known.
-void OrderOrchestrator::call_robot_when_ready(const char* how) {
-  if (robot_called_ || station_.empty() || buffer_of_.size() < parts_per_type().size()) return;
-  robot_called_ = true;
-  std::vector<std::string> sources;
-  for (const auto& step : plan_.steps) {
-    if (!inserts_unit(step)) sources.push_back(buffer_of_.at(short_type_name(product_.product.parts()[step.part].type)));
-  }
-  emit(how, call_data(kRobot, "fetch", "", station_, fb::join_names(sources), static_cast<long>(sources.size()), 0));
 }
 
 // --- quotes --------------------------------------------------------------------------------
@@ -388,52 +356,47 @@ void OrderOrchestrator::call_robot_when_ready(const char* how) {
 void OrderOrchestrator::ask_for_quotes() {
   waiting_since_ = std::chrono::steady_clock::now();
   status("WAITING", "virtual assembly done; asking the cell's resources for quotes", 0);
-  emit("ASK", call_data(kHost, kHost, "", "", "", 0, std::max(0.0, hold_at(virtual_station_))));
-  for (const auto& [type, count] : parts_per_type()) emit("ASK", call_data(kGive + type, "give", type, "", "", count, 0));
-}
-
-// How long the bidder's queue holds the work up, on the bidder's own clock (the twin's may
-// run a little ahead or behind it).
-double OrderOrchestrator::queue_of(const Data& quoted) {
-  return std::max(0.0, get<double>(quoted, "earliest_start") - get<double>(quoted, "bid_time"));
+  emit("ASK", booking_.host("", std::max(0.0, hold_at(virtual_station_))));
+  for (const Data& give : booking_.gives(fetched_types())) emit("ASK", give);
 }
 
 void OrderOrchestrator::on_quoted(const Data& d) {
-  const std::string what = get<std::string>(d, "call_id").substr(settings_.order_id.size() + 1);
-  const std::string& resource = get<std::string>(d, "resource_id");
-  if (what == kHost) {
-    station_ = resource;
-    station_wait_ = queue_of(d);
-  } else if (what.rfind(kGive, 0) == 0) {
-    buffer_of_[what.substr(kGive.size())] = resource;
-  } else if (what == kRobot) {
-    robot_ = resource;
-    robot_wait_ = queue_of(d);
-    return quote_when_arm_known();
+  switch (booking_.quoted(d)) {
+    case Booking::For::host:
+      station_wait_ = Booking::queue_of(d);
+      break;
+    case Booking::For::robot:
+      robot_wait_ = Booking::queue_of(d);
+      return quote_when_arm_known();
+    default:
+      break;
   }
-  call_robot_when_ready("ASK");
+  if (const auto robot = booking_.robot_when_ready(fetched_types())) emit("ASK", *robot);
 }
 
 // The arm's model needs its speed: its capability may come later than the station's. The
 // station is the order's after its queue; the robot sets out once the station is the
 // order's and its own earlier work is done.
 void OrderOrchestrator::quote_when_arm_known() {
-  if (robot_.empty() || !arm_at(station_) || !knows_places()) return;
+  if (booking_.robot().empty() || !arm_at(booking_.station()) || !knows_places()) return;
   const ModelledRun run = modelled(hired(), station_wait_, robot_wait_);
-  raise("PRICED", {{"station", station_}, {"robot", robot_}, {"wait", run.start}, {"makespan", run.end},
-                   {"robot_s", run.robot_s}});
+  raise("PRICED", {{"station", booking_.station()}, {"robot", booking_.robot()}, {"wait", run.start},
+                   {"makespan", run.end}, {"robot_s", run.robot_s}});
 }
 
 // Also once the places of the station and the buffers are known: a resource's proposal may
 // come before its capability (DDS matches each pair of endpoints on its own).
 void OrderOrchestrator::start_physical_when_hired() {
-  if (state() == Phase::hiring && !robot_.empty() && !arm_.empty() && arm_held_ && knows_places()) raise("HIRED");
+  if (state() == Phase::hiring && !booking_.robot().empty() && !booking_.arm_resource().empty() && arm_held_ &&
+      knows_places()) {
+    raise("HIRED");
+  }
 }
 
 bool OrderOrchestrator::knows_places() const {
-  return places_.count(station_) && std::all_of(buffer_of_.begin(), buffer_of_.end(), [this](const auto& b) {
-           return places_.count(b.second) > 0;
-         });
+  const auto& buffers = booking_.buffer_of();
+  return places_.count(booking_.station()) &&
+         std::all_of(buffers.begin(), buffers.end(), [this](const auto& b) { return places_.count(b.second) > 0; });
 }
 
 // --- scripts -------------------------------------------------------------------------------
@@ -453,15 +416,23 @@ std::string OrderOrchestrator::virtual_body(PartIndex part) const {
   return settings_.order_id + "/virtual/" + product_.product.parts()[part].name;
 }
 
+std::vector<std::string> OrderOrchestrator::fetched_types() const {
+  std::vector<std::string> out;
+  for (const auto& step : plan_.steps) {
+    if (!inserts_unit(step)) out.push_back(short_type_name(product_.product.parts()[step.part].type));
+  }
+  return out;
+}
+
 Location OrderOrchestrator::location(const std::string& resource) const {
   const Place& p = places_.at(resource);
   return {p.position, p.dock};
 }
 
 Hired OrderOrchestrator::hired() const {
-  Hired h{settings_.order_id, station_, arm_, robot_, buffer_of_, {}};
-  h.places[station_] = location(station_);
-  for (const auto& [type, buffer] : buffer_of_) h.places[buffer] = location(buffer);
+  Hired h{settings_.order_id, booking_.station(), booking_.arm_resource(), booking_.robot(), booking_.buffer_of(), {}};
+  h.places[h.station] = location(h.station);
+  for (const auto& [type, buffer] : h.buffer_of) h.places[buffer] = location(buffer);
   return h;
 }
 
@@ -469,7 +440,7 @@ Data OrderOrchestrator::command(const std::string& resource, const std::string& 
   const std::string attempt = settings_.resume.attempt > 1 ? "r" + std::to_string(settings_.resume.attempt) + "/" : "";
   return {{"command_id", settings_.order_id + "/" + attempt + std::to_string(++command_count_) + "/" + operation},
           {"resource_id", resource}, {"order_id", settings_.order_id}, {"operation", operation}, {"part", part},
-          {"award", award_of_[resource]}};
+          {"award", booking_.award_of(resource)}};
 }
 
 // Virtual assembly of one candidate trajectory, all in cell-sim: the part and a gripper of
@@ -644,7 +615,7 @@ void OrderOrchestrator::back_to_sequence_planning() {
 
 void OrderOrchestrator::plan_physical() {
   const auto& resume = settings_.resume;
-  status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ +
+  status("PHYSICAL_ASSEMBLY", "physical assembly at " + booking_.station() +
                                   (resume.used.empty() ? "" : " (taken up again: " + std::to_string(resume.placed.size()) +
                                                                   " parts in place, " +
                                                                   (resume.aside.empty() ? "" : std::to_string(resume.aside.size()) + " built aside, ") +
@@ -730,7 +701,7 @@ void OrderOrchestrator::action_done() {
     emit("PLACED", placed->second);
     placed_by_.erase(placed);
     const std::size_t left = placed_by_.size();
-    status("PHYSICAL_ASSEMBLY", "physical assembly at " + station_ + ": " +
+    status("PHYSICAL_ASSEMBLY", "physical assembly at " + booking_.station() + ": " +
                                     std::to_string(plan_.steps.size() - left) + " of " +
                                     std::to_string(plan_.steps.size()) + " steps",
            double(plan_.steps.size() - left) / plan_.steps.size());
@@ -788,13 +759,13 @@ void OrderOrchestrator::fail(const std::string& reason) {
 }
 
 void OrderOrchestrator::finish() {
-  for (const std::string& resource : awarded_) {
+  for (const std::string& resource : booking_.to_release()) {
     emit("RELEASE", {{"order_id", settings_.order_id}, {"resource_id", resource}});
   }
   if (settings_.quote_only) {
     // Not feasible here is the quote's answer, which its caller gives.
   } else if (error_.empty()) {
-    status("DONE", "assembled " + std::to_string(product_.product.parts().size()) + " parts at " + station_, 1);
+    status("DONE", "assembled " + std::to_string(product_.product.parts().size()) + " parts at " + booking_.station(), 1);
   } else {
     status("FAILED", error_, 0);
   }

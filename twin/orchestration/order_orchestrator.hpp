@@ -83,6 +83,7 @@
 #include "services/node/sim_requests.hpp"
 #include "services/runtime/basic_block.hpp"
 #include "twin/orchestration/assembly_script.hpp"
+#include "twin/orchestration/booking.hpp"
 #include "twin/orchestration/execution_model.hpp"
 #include "twin/planning/assembly_planner.hpp"
 #include "twin/report/timeline.hpp"
@@ -153,15 +154,11 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   void on_resource_gone(const std::string& id);
   void hire();
   void on_awarded(const fb::Data& award);
-  void call_robot_when_ready(const char* how);  // CALL or ASK
   const Place* arm_at(const std::string& station) const;  // its arm, once its capability is heard
   // Quotes.
   void ask_for_quotes();
   void on_quoted(const fb::Data& quote);
   void quote_when_arm_known();
-  static double queue_of(const fb::Data& quoted);
-  fb::Data call_data(const std::string& what, const std::string& operation, const std::string& type,
-                     const std::string& station, const std::string& sources, long count, double duration) const;
   void start_physical_when_hired();
   // Scripts.
   void add_candidate(std::size_t step, std::size_t candidate);
@@ -183,12 +180,12 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   std::vector<Trajectory> candidates(std::size_t step) const;
   std::string virtual_body(PartIndex part) const;
   Location location(const std::string& resource) const;  // from its capability
-  Hired hired() const;
-  bool knows_places() const;  // of the station and the buffers: their capabilities were heard  // the station, arm, robot and buffers awarded, with their places
+  Hired hired() const;        // the station, arm, robot and buffers awarded, with their places
+  bool knows_places() const;  // of the station and the buffers: their capabilities were heard
   // The physical script for `h` timed against the resources' models (execution_model.hpp).
   ModelledRun modelled(const Hired& h, double station_free, double robot_free) const;
   std::vector<std::string> virtual_gripper() const;  // its bodies in the order's scene, the palm first
-  std::map<std::string, int> parts_per_type() const;
+  std::vector<std::string> fetched_types() const;  // of each part a step fetches, in planned order
   bool waited_too_long() const;
 
   const LoadedProduct& product_;
@@ -206,14 +203,9 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
   std::string virtual_station_;
   bool sim_answers_ = false;
-  // Physical assembly: what was awarded.
-  std::string station_, arm_, robot_;
-  std::map<std::string, std::string> buffer_of_;  // part type -> buffer
-  std::set<std::string> awarded_;                 // every resource to release at the end
-  std::map<std::string, std::string> award_of_;   // resource -> the call it was awarded (commands name it)
-  long ahead_ = -1;                               // in the station's queue, as last reported
+  Booking booking_;  // what was called for and awarded (or quoted)
+  long ahead_ = -1;  // in the station's queue, as last reported
   bool arm_held_ = false;
-  bool robot_called_ = false;
   double station_wait_ = 0, robot_wait_ = 0;  // quotes: the best bids' queues
 
   std::set<std::string> delivered_, spawned_;
