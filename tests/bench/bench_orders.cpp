@@ -1,10 +1,15 @@
 // Benchmark of many orders on a cell: `cellctl run` of N mixed orders (Lego towers and
 // Cranfield pendulums in turn) on a deployment file, and from its event log and its table:
 //  - the makespan in sim seconds (first order's start to last order's end);
-//  - the lower bound: the arms' busy time over all orders divided by the number of
-//    stations, or the longest single order, whichever is larger. A single order's length is
-//    its own work: from its first command to its last, plus the time before any order could
-//    start physical work (planning and virtual assembly);
+//  - the lower bound: the arms' work shared by all arms at once, or the longest single
+//    order, whichever is larger. An arm's work is its busy time times its speed (metres:
+//    arms of different speeds, as in mixed-stations.yaml, turn at the same angular speed),
+//    and all arms together do sum(speed) metres a second: for equal arms, the busy time over
+//    the number of stations. A single order's length is its own work: from its first command
+//    to its last, plus the time before any order could start physical work (planning and
+//    virtual assembly);
+//  - each arm's idle time at a change of order (its last command for one order to its first
+//    for the next);
 //  - the peak RSS of every process (cellctl's table: cell processes, and each twin).
 // BENCH_KEEP=1 keeps the event log and the twins' output in the temporary directory.
 // Run: build/release/bin/bench_orders [--orders 10] [--cell deploy/cells/two-stations.yaml]
@@ -40,10 +45,20 @@ struct Span {
   }
 };
 
-std::size_t stations_of(const std::string& cell_file) {
+// Arm id -> its speed (m/s), from the deployment file.
+std::map<std::string, double> arm_speeds(const std::string& cell_file) {
   const YAML::Node cell = YAML::LoadFile(cell_file);
-  if (cell["stations"]) return cell["stations"].size();
-  return 1;
+  std::map<std::string, double> out;
+  const auto add = [&out](const YAML::Node& station) {
+    out[station["arm"] ? station["arm"].as<std::string>() : "arm-1"] =
+        station["arm_speed"] ? station["arm_speed"].as<double>() : 0.25;
+  };
+  if (cell["stations"]) {
+    for (const auto& station : cell["stations"]) add(station);
+  } else {
+    add(cell["station"] ? cell["station"] : YAML::Node());
+  }
+  return out;
 }
 
 }  // namespace
@@ -81,7 +96,7 @@ int main(int argc, char** argv) {
 
   // The arms' busy time: every arm command from accepted to its end, physical parts only.
   std::map<std::string, Span> commands, of_order;
-  std::map<std::string, std::string> arm_of;
+  std::map<std::string, std::string> arm_of, order_of;
   std::ifstream events(dir / "events.jsonl");
   for (std::string line; std::getline(events, line);) {
     const json e = json::parse(line);
@@ -91,28 +106,47 @@ int main(int argc, char** argv) {
     if (resource.rfind("arm-", 0) == 0) {
       commands[e["command"]].add(t);
       arm_of[e["command"]] = resource;
+      order_of[e["command"]] = e["order"];
     }
   }
-  double arm_busy = 0;
-  for (const auto& [id, span] : commands) arm_busy += span.end - span.start;
+  const std::map<std::string, double> speeds = arm_speeds(cell);
+  double arm_busy = 0, arm_work = 0, all_speeds = 0;
+  for (const auto& [id, span] : commands) {
+    arm_busy += span.end - span.start;
+    arm_work += (span.end - span.start) * speeds.at(arm_of[id]);
+  }
+  for (const auto& [arm, speed] : speeds) all_speeds += speed;
 
-  // Where each arm's time went: its first command, its last, and the gaps between commands.
-  std::map<std::string, std::vector<Span>> spans_of_arm;
-  for (const auto& [id, span] : commands) spans_of_arm[arm_of[id]].push_back(span);
+  // Where each arm's time went: its first command, its last, the gaps between commands, and
+  // those at a change of order.
+  struct Command {
+    Span span;
+    std::string order;
+  };
+  std::map<std::string, std::vector<Command>> of_arm;
+  for (const auto& [id, span] : commands) of_arm[arm_of[id]].push_back({span, order_of[id]});
   std::ostringstream arms;
-  for (auto& [arm, spans] : spans_of_arm) {
-    std::sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) { return a.start < b.start; });
-    double busy = 0, idle = 0, long_idle = 0, end = spans.front().start;
-    int long_gaps = 0;
-    for (const Span& s : spans) {
+  std::vector<double> changes;
+  for (auto& [arm, done] : of_arm) {
+    std::sort(done.begin(), done.end(), [](const Command& a, const Command& b) { return a.span.start < b.span.start; });
+    double busy = 0, idle = 0, long_idle = 0, end = done.front().span.start;
+    int long_gaps = 0, orders_here = 1;
+    for (std::size_t i = 0; i < done.size(); ++i) {
+      const Span& s = done[i].span;
       busy += s.end - s.start;
       const double gap = std::max(0.0, s.start - end);
       idle += gap;
       if (gap > 1.0) ++long_gaps, long_idle += gap;
+      if (i > 0 && done[i].order != done[i - 1].order) ++orders_here, changes.push_back(gap);
       end = std::max(end, s.end);
     }
-    arms << "  " << arm << ": first command " << spans.front().start << ", last end " << end << ", busy " << busy
-         << ", idle between " << idle << " (" << long_gaps << " gaps over 1 s: " << long_idle << ")\n";
+    arms << "  " << arm << " (" << speeds.at(arm) << " m/s): " << orders_here << " orders, first command "
+         << done.front().span.start << ", last end " << end << ", busy " << busy << ", idle between " << idle << " ("
+         << long_gaps << " gaps over 1 s: " << long_idle << ")\n";
+  }
+  if (!changes.empty()) {
+    arms << "  idle at a change of order: mean " << std::accumulate(changes.begin(), changes.end(), 0.0) / changes.size()
+         << ", max " << *std::max_element(changes.begin(), changes.end()) << " sim s (" << changes.size() << " changes)\n";
   }
 
   // Sim start and end per order, and the makespan, from cellctl's table.
@@ -135,13 +169,13 @@ int main(int argc, char** argv) {
   }
   for (const auto& [order, span] : of_order) before_work = std::min(before_work, span.start - first_start);
   for (const auto& [order, span] : of_order) longest = std::max(longest, span.end - span.start + before_work);
-  const std::size_t stations = stations_of(cell);
-  const double bound = std::max(arm_busy / stations, longest);
+  const std::size_t stations = speeds.size();
+  const double bound = std::max(arm_work / all_speeds, longest);
 
   std::cout << "cell " << fs::path(cell).filename().string() << " (" << stations << " stations), " << orders
             << " orders, real-time factor " << factor << ", " << static_cast<int>(wall) << " s wall\n"
             << "  makespan " << makespan << " sim s\n"
-            << "  arm busy " << arm_busy << " sim s over " << stations << " stations: " << arm_busy / stations << "\n"
+            << "  arm busy " << arm_busy << " sim s; shared by the " << stations << " arms: " << arm_work / all_speeds << "\n"
             << "  longest single order " << longest << " sim s (of it " << before_work << " before any physical work)\n"
             << arms.str() << "  lower bound " << bound << " sim s; makespan / bound " << makespan / bound << "\n"
             << "  peak RSS MB: twin (largest) " << twin_rss;
