@@ -1,8 +1,7 @@
 #include "services/mobile_robot/mobile_robot_block.hpp"
 
-#include <cmath>
-
 #include "services/state/cell_store.hpp"
+#include "sim/world/motion_time.hpp"
 
 namespace fb {
 
@@ -143,14 +142,13 @@ Contractor::Estimate MobileRobotBlock::estimate(const std::vector<std::string>& 
     return Contractor::Estimate{false, "no dock known for '" + place + "'", 0};
   };
   Contractor::Estimate e;
-  const auto distance = [](const Numbers& a, const Numbers& b) { return std::hypot(a[0] - b[0], a[2] - b[2]); };
   Numbers at = work_ends_at_;
   if (!docks_.count(destination)) return unknown(destination);
   const Numbers& to = docks_.at(destination);
   for (const auto& source : sources) {
     const auto it = docks_.find(source);
     if (it == docks_.end()) return unknown(source);
-    e.duration += (distance(at, it->second) + distance(it->second, to)) / speed_;
+    e.duration += (sim::floor_distance(at, it->second) + sim::floor_distance(it->second, to)) / speed_;
     at = to;
   }
   e.available = true;

@@ -1,6 +1,5 @@
 #include "twin/orchestration/execution_model.hpp"
 
-#include <cmath>
 #include <stdexcept>
 
 #include "services/node/gripper.hpp"
@@ -18,8 +17,6 @@ const Numbers& dock_of(const ResourceModels& models, const std::string& id) {
   if (it == models.docks.end() || it->second.size() < 3) throw std::invalid_argument("no dock known for '" + id + "'");
   return it->second;
 }
-
-double flat_distance(const Numbers& a, const Numbers& b) { return std::hypot(a[0] - b[0], a[2] - b[2]); }
 
 // The arm's gripper along a motion's path from where it is: cell-sim's time for each segment.
 double arm_motion(const Data& command, const ResourceModels& models, Pose& gripper) {
@@ -56,7 +53,7 @@ ModelledRun run_script(const Script& script, const ResourceModels& models, doubl
         const Numbers& source = dock_of(models, get<std::string>(a.data, "source"));
         const Numbers& destination = dock_of(models, get<std::string>(a.data, "destination"));
         const double drive =
-            (flat_distance(robot_at, source) + flat_distance(source, destination)) / models.robot_speed;
+            (sim::floor_distance(robot_at, source) + sim::floor_distance(source, destination)) / models.robot_speed;
         robot_ready = std::max(robot_ready, now) + drive + fetch;
         run.robot_s += drive;
         robot_at = destination;

@@ -254,14 +254,26 @@ ModelledRun OrderOrchestrator::modelled(const Hired& h, double station_free, dou
   return run_script(script.actions, models, station_free, robot_free);
 }
 
+// The script is built and run again only when what it depends on changed: the bidding asks
+// for every station's hold at each decision.
 double OrderOrchestrator::hold_at(const std::string& station) const {
-  if (!places_.count(station)) return -1;
+  const auto place = places_.find(station);
+  if (place == places_.end()) return -1;
+  const Place* arm = arm_at(station);
+  std::vector<double> depends_on = place->second.position;
+  depends_on.insert(depends_on.end(), place->second.dock.begin(), place->second.dock.end());
+  depends_on.push_back(arm ? arm->speed : settings_.arm_speed);
+  depends_on.push_back(arm ? arm->angular_speed : settings_.arm_angular_speed);
+  depends_on.push_back(settings_.real_time_factor ? settings_.real_time_factor() : 0);
+  auto& known = holds_[station];
+  if (known.first == depends_on) return known.second;
   // Every part at the dock already: what the arm does there.
   Hired h{settings_.order_id, station, "arm", "", {}, {}};
   h.places[station] = location(station);
   for (const auto& type : fetched_types()) h.buffer_of[type] = station;
   const ModelledRun run = modelled(h, 0, 0);
-  return run.end - run.start;
+  known = {depends_on, run.end - run.start};
+  return known.second;
 }
 
 void OrderOrchestrator::book(std::string only) {
@@ -608,6 +620,7 @@ void OrderOrchestrator::back_to_sequence_planning() {
                    {"part", name}});
   replanned.findings = plan_.findings;
   plan_ = std::move(replanned);
+  holds_.clear();
   candidate_ = 0;
   add_candidate(step_, 0);
   next_action();

@@ -204,6 +204,8 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   std::string virtual_station_;
   bool sim_answers_ = false;
   Booking booking_;  // what was called for and awarded (or quoted)
+  // hold_at's answers: station -> (what they were computed from, the hold).
+  mutable std::map<std::string, std::pair<std::vector<double>, double>> holds_;
   long ahead_ = -1;  // in the station's queue, as last reported
   bool arm_held_ = false;
   double station_wait_ = 0, robot_wait_ = 0;  // quotes: the best bids' queues
