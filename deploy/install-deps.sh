@@ -22,6 +22,7 @@ packages=(
   nettle-dev     # SHA-256 of the mesh cache's keys, base64 (light to load: cellctl plan's start)
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
+  libcpp-httplib-dev  # cellctl up's dashboard: its HTTP server
 )
 if $tests; then
   packages+=(

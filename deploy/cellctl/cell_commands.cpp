@@ -1,7 +1,9 @@
 #include "deploy/cellctl/cell_commands.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -10,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -17,6 +20,7 @@
 #include "deploy/cellctl/cell_observer.hpp"
 #include "deploy/cellctl/cell_roster.hpp"
 #include "deploy/cellctl/cell_status.hpp"
+#include "deploy/cellctl/dashboard.hpp"
 #include "deploy/cellctl/host_limits.hpp"
 #include "deploy/cellctl/order_desk.hpp"
 #include "deploy/cellctl/processes.hpp"
@@ -371,6 +375,22 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
   }
 }
 
+// The dashboard, its address printed and its token kept beside the cell's state (0600) for
+// the operator who did not see the print.
+std::unique_ptr<Dashboard> open_dashboard(const DashboardAddress& at, const CellConfig& cell, const CellObserver& observer) {
+  auto page = std::make_unique<Dashboard>(at, cell, observer);
+  const fs::path token_file = cell.state_folder() / "dashboard.token";
+  fs::create_directories(cell.state_folder());
+  fs::remove(token_file);
+  const int fd = ::open(token_file.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);  // never readable by others
+  const std::string line = page->token() + "\n";
+  const bool written = fd >= 0 && ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size());
+  if (fd >= 0) ::close(fd);
+  if (!written) throw std::runtime_error("cannot write the dashboard's token to " + token_file.string());
+  std::cout << "dashboard: " << page->url() << " (the token is in " << token_file.string() << ")" << std::endl;
+  return page;
+}
+
 // The orders' table and the makespan; true when every order was assembled.
 bool report_orders(const std::vector<Order>& orders, CellObserver& observer) {
   const auto statuses = observer.orders();
@@ -403,8 +423,15 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
   CLI::App* up = app.add_subcommand("up", "Start the cell of a deployment file and supervise it");
   add_cell_options(up, *cell_options);
   up->add_option("CELL", cell_options->cell, "Deployment file (the same as --cell)")->check(CLI::ExistingFile);
-  up->callback([cell_options, &exit_code] {
-    const CellConfig cell = cell_options->load();
+  auto dashboard = std::make_shared<std::string>();
+  up->add_option("--dashboard", *dashboard,
+                 "Serve the cell's live page at [ADDR:]PORT (loopback unless ADDR; 0: any free port), instead of the "
+                 "file's dashboard (docs/dashboard.md)");
+  up->callback([cell_options, dashboard, &exit_code] {
+    CellConfig cell = cell_options->load();
+    if (!dashboard->empty()) cell.dashboard = *dashboard;
+    const std::optional<DashboardAddress> dashboard_at =
+        cell.dashboard.empty() ? std::nullopt : std::optional(parse_dashboard_address(cell.dashboard));
     cell.check_twin_identities();
     check_host_limits(cell, static_cast<std::size_t>(cell.max_twins), "max_twins");
     std::signal(SIGINT, request_stop);
@@ -417,6 +444,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     }
     if (stale) std::cerr << "cellctl up: the last cellctl up on this domain was killed; starting the cell afresh\n";
     CellObserver observer(cell.participant_settings("order-desk"));
+    // Before anything starts: a port that is taken stops up here, and the page shows the start.
+    const std::unique_ptr<Dashboard> page = dashboard_at ? open_dashboard(*dashboard_at, cell, observer) : nullptr;
     const RosterWriter roster(observer.participant(), cell);
     state::CellStore store(cell.state_folder());
     store.journal("cellctl", "up", "", "domain " + std::to_string(cell.domain));
@@ -425,6 +454,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
                           [&](const std::string& process, const std::string& event, const std::string& what) {
                             std::cerr << "cellctl up: " << what << std::endl;
                             store.journal(process, event, "", what);
+                            observer.note_change();  // the dashboard shows it now
                             world_lost |= event == "restarting all";
                           });
     // Before the cell is up: a submit that sees the cell's resources finds its state too.

@@ -210,7 +210,8 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
-              "setup_cost", "currency", "standby_twins", "max_twins", "twin_identities", "fixtures", "discovery"});
+              "setup_cost", "currency", "standby_twins", "max_twins", "twin_identities", "fixtures", "discovery",
+              "dashboard"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -254,6 +255,14 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   read(file, root, "twin_identities", c.twin_identities);
   if (c.twin_identities < 1 || c.twin_identities > 256) {
     throw ConfigError(where(file, root["twin_identities"]) + ": twin_identities must be 1..256");
+  }
+  read(file, root, "dashboard", c.dashboard);
+  if (!c.dashboard.empty()) {
+    try {
+      parse_dashboard_address(c.dashboard);
+    } catch (const ConfigError& e) {
+      throw ConfigError(where(file, root["dashboard"]) + ": " + e.what());
+    }
   }
   read_cost(file, root, "setup_cost", c.setup_cost);
   read(file, root, "currency", c.currency);
@@ -512,6 +521,22 @@ std::vector<ProcessSpec> cell_processes(const CellConfig& c, const std::filesyst
     out.insert(out.begin(), server);
   }
   return out;
+}
+
+DashboardAddress parse_dashboard_address(const std::string& text) {
+  DashboardAddress a;
+  std::string port = text;
+  if (const std::size_t colon = text.rfind(':'); colon != std::string::npos) {
+    a.host = text.substr(0, colon);
+    port = text.substr(colon + 1);
+  }
+  const bool digits = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
+  a.port = digits ? std::stoi(port) : -1;
+  if (a.port < 0 || a.port > 65535 || a.host.empty()) {
+    throw ConfigError("dashboard: '" + text + "' is not [ADDR:]PORT (a port 0-65535, 0 any free one; e.g. 8080 or "
+                      "127.0.0.1:8080)");
+  }
+  return a;
 }
 
 }  // namespace cellctl

@@ -50,6 +50,14 @@ struct RestartPolicy {
 
 // `desk: {max_order_mb: 64, orders_per_minute: 60, max_orders: 1000}`: what the order desk takes
 // from remote clients (docs/order-desk.md); past a limit it refuses with the reason.
+// Where `cellctl up` serves the cell's dashboard (deploy/cellctl/dashboard.hpp).
+struct DashboardAddress {
+  std::string host = "127.0.0.1";
+  int port = 0;  // 0: any free port (the address up prints says which)
+};
+// "8080", "127.0.0.1:8080", "0.0.0.0:8080", "0"; throws ConfigError with the reason.
+DashboardAddress parse_dashboard_address(const std::string& text);
+
 struct DeskLimits {
   double max_order_mb = 64;   // the product's files, all together
   int orders_per_minute = 6;  // per client
@@ -111,6 +119,9 @@ struct CellConfig {
   // `twin_identities:` with security, the twins that may run at once, standby ones included:
   // each has a certificate of its own, twin-1 .. twin-N (deploy/cellctl/twin_identities.hpp).
   int twin_identities = 10;
+  // `dashboard: [ADDR:]PORT`: cellctl up serves the cell's live page there (loopback unless
+  // ADDR says otherwise); empty: no dashboard, unless `up --dashboard` asks for one.
+  std::string dashboard;
 
   std::vector<std::string> resource_ids() const;
   // The servers every participant of the cell uses ("IP:PORT"); empty: simple discovery.

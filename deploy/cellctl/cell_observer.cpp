@@ -10,10 +10,6 @@
 #include "services/dds/sim_clock.hpp"
 
 namespace cellctl {
-namespace {
-
-
-}  // namespace
 
 struct CellObserver::Impl {
   dds::ParticipantPtr participant;
@@ -30,13 +26,23 @@ CellObserver::CellObserver(const dds::ParticipantSettings& settings) : impl_(std
     {
       std::lock_guard<std::mutex> lock(mutex_);
       f();
+      ++version_;
+      changed_at_ = std::chrono::system_clock::now();
     }
     changed_.notify_all();
   };
   impl_->capabilities = std::make_unique<dds::Reader<cell::Capability, cell::CapabilityPubSubType>>(
       impl_->participant, "cell/capabilities", dds::TopicKind::state,
-      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id().to_string()] = {c, true}; }); },
-      [this, changed](const cell::Capability& c) { changed([&] { resources_[c.resource_id().to_string()] = {c, false}; }); });
+      [this, changed](const cell::Capability& c) {
+        changed([&] { resources_[c.resource_id().to_string()] = {c, true, std::chrono::system_clock::now()}; });
+      },
+      [this, changed](const cell::Capability& c) {
+        changed([&] {
+          ResourceView& r = resources_[c.resource_id().to_string()];
+          r.capability = c;
+          r.alive = false;
+        });
+      });
   impl_->statuses = std::make_unique<dds::Reader<cell::OrderStatus, cell::OrderStatusPubSubType>>(
       impl_->participant, "cell/orders/status", dds::TopicKind::state, [this, changed](const cell::OrderStatus& s) {
         changed([&] { orders_[s.order_id().to_string()] = s; });
@@ -48,7 +54,14 @@ CellObserver::CellObserver(const dds::ParticipantSettings& settings) : impl_(std
         if (callback) callback(s);
       });
   impl_->events = std::make_unique<dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>>(
-      impl_->participant, "cell/command_events", dds::TopicKind::events, [this](const cell::CommandEvent& e) {
+      impl_->participant, "cell/command_events", dds::TopicKind::events, [this, changed](const cell::CommandEvent& e) {
+        changed([&] {
+          command_events_.push_back({++command_seq_, e.resource_id().to_string(), e.order_id().to_string(),
+                                     e.operation().to_string(), e.part().to_string(), e.command_id().to_string(),
+                                     e.state(), e.reason().to_string(), e.sim_time(),
+                                     std::chrono::system_clock::now()});
+          if (command_events_.size() > kKeptCommandEvents) command_events_.pop_front();
+        });
         std::lock_guard<std::mutex> lock(mutex_);
         if (!events_.is_open()) return;
         nlohmann::json line{{"t", e.sim_time()},
@@ -115,6 +128,37 @@ std::map<std::string, cell::OrderStatus> CellObserver::orders() const {
 }
 
 double CellObserver::sim_now() const { return impl_->clock->now(); }
+
+std::uint64_t CellObserver::version() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return version_;
+}
+
+void CellObserver::note_change() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++version_;
+  }
+  changed_.notify_all();
+}
+
+std::uint64_t CellObserver::wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait_for(lock, timeout, [&] { return version_ != seen; });
+  return version_;
+}
+
+std::chrono::system_clock::time_point CellObserver::changed_at() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return changed_at_;
+}
+
+std::vector<CommandHeard> CellObserver::command_events_after(std::uint64_t after) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<CommandHeard> out;
+  for (auto it = command_events_.rbegin(); it != command_events_.rend() && it->seq > after; ++it) out.push_back(*it);
+  return {out.rbegin(), out.rend()};
+}
 
 std::size_t CellObserver::events_logged() const {
   std::lock_guard<std::mutex> lock(mutex_);

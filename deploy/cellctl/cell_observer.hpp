@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
+#include <deque>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "capabilities.h"
+#include "commands.h"
 #include "orders.h"
 #include "services/dds/participant.hpp"
 
@@ -22,6 +25,17 @@ namespace cellctl {
 struct ResourceView {
   cell::Capability capability;
   bool alive = true;
+  std::chrono::system_clock::time_point heard_at;  // its last capability
+};
+
+// One command event as the observer heard it, for those that follow the cell's work.
+struct CommandHeard {
+  std::uint64_t seq = 0;  // 1, 2, ... in the order heard
+  std::string resource, order, operation, part, command;
+  cell::CommandState state = cell::ACCEPTED;
+  std::string reason;
+  double sim_time = 0;
+  std::chrono::system_clock::time_point heard_at;
 };
 
 class CellObserver {
@@ -44,10 +58,27 @@ class CellObserver {
   std::size_t events_logged() const;
   double sim_now() const;  // the cell's sim time, s (0 before cell-sim's clock is heard)
 
+  // Grows with every capability, order status and command event heard, and note_change().
+  std::uint64_t version() const;
+  // A change of the cell that DDS does not carry (a process ended: the journal says so).
+  void note_change();
+  // Waits until version() passes `seen`; the version then (`seen` after the timeout).
+  std::uint64_t wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const;
+  // When the change that made the current version was heard.
+  std::chrono::system_clock::time_point changed_at() const;
+  // The command events heard after `after` (a CommandHeard::seq), oldest first; the observer
+  // keeps the last kKeptCommandEvents.
+  std::vector<CommandHeard> command_events_after(std::uint64_t after) const;
+  static constexpr std::size_t kKeptCommandEvents = 20000;
+
  private:
   struct Impl;
   mutable std::mutex mutex_;
-  std::condition_variable changed_;
+  mutable std::condition_variable changed_;
+  std::uint64_t version_ = 0;
+  std::chrono::system_clock::time_point changed_at_{};
+  std::deque<CommandHeard> command_events_;
+  std::uint64_t command_seq_ = 0;
   std::map<std::string, ResourceView> resources_;
   std::map<std::string, cell::OrderStatus> orders_;
   std::function<void(const cell::OrderStatus&)> on_status_;

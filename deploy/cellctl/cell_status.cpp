@@ -11,14 +11,6 @@
 namespace cellctl {
 namespace {
 
-// The process a resource lives in, whose restarts are its restarts (an arm's is its station's).
-std::string process_of(const CellConfig& cell, const std::string& resource) {
-  for (const auto& s : cell.stations) {
-    if (s.arm == resource) return s.id;
-  }
-  return resource;
-}
-
 const char* state_of(cell::OrderState state) {
   static const char* names[] = {"SUBMITTED", "PLANNING", "VIRTUAL_ASSEMBLY", "WAITING", "PHYSICAL_ASSEMBLY", "DONE",
                                 "FAILED"};
@@ -27,10 +19,21 @@ const char* state_of(cell::OrderState state) {
 
 }  // namespace
 
+std::string process_of(const CellConfig& cell, const std::string& resource) {
+  for (const auto& s : cell.stations) {
+    if (s.arm == resource) return s.id;
+  }
+  return resource;
+}
+
 nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer) {
-  using nlohmann::json;
   std::optional<state::CellStore> store;
   if (std::filesystem::exists(state::CellStore::file_in(cell.state_folder()))) store.emplace(cell.state_folder());
+  return cell_status(cell, observer, store ? &*store : nullptr);
+}
+
+nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer, const state::CellStore* store) {
+  using nlohmann::json;
 
   json inventory = json::object();
   if (store) {
@@ -51,6 +54,10 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer)
     for (const auto& o : stored) {
       json order = {{"order", o.order}, {"state", o.state}, {"reason", o.reason}, {"quote", o.quote}};
       if (const std::size_t place = OrderDesk::place_in(queue, o.order)) order["place"] = place;
+      if (const auto it = live.find(o.order); it != live.end()) {
+        order["progress"] = it->second.progress();
+        order["message"] = it->second.message().to_string();
+      }
       orders.push_back(order);
       listed.insert(o.order);
     }
@@ -59,7 +66,7 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer)
     if (listed.count(id)) continue;
     const bool failed = s.state() == cell::FAILED;
     orders.push_back({{"order", id}, {"state", state_of(s.state())}, {"reason", failed ? s.message().to_string() : ""},
-                      {"quote", false}});
+                      {"quote", false}, {"progress", s.progress()}, {"message", s.message().to_string()}});
   }
 
   json resources = json::array();
@@ -69,15 +76,28 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer)
   for (const auto& [id, r] : seen) ids.insert(id);
   for (const auto& id : ids) {
     const auto it = seen.find(id);
-    json stock = json::object();
+    json resource = {{"id", id},
+                     {"alive", it != seen.end() && it->second.alive},
+                     {"reserved_by", ""},
+                     {"restarts", store ? store->count_events(process_of(cell, id), "restarted") : 0},
+                     {"stock", json::object()}};
     if (it != seen.end()) {
-      for (const auto& s : it->second.capability.stock()) stock[s.part_type().to_string()] = s.count();
+      const cell::Capability& c = it->second.capability;
+      for (const auto& s : c.stock()) resource["stock"][s.part_type().to_string()] = s.count();
+      json waiting = json::array();
+      for (const auto& w : c.waiting()) waiting.push_back(w.to_string());
+      const auto xyz = [](const cell::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
+      resource.update({{"kind", c.kind().to_string()},
+                       {"reserved_by", c.reserved_by().to_string()},
+                       {"waiting", waiting},
+                       {"busy", c.busy()},
+                       {"queued", c.queued_commands()},
+                       {"refused", c.refused_commands()},
+                       {"last_refusal", c.last_refusal().to_string()},
+                       {"position", xyz(c.position())},
+                       {"dock", xyz(c.dock())}});
     }
-    resources.push_back({{"id", id},
-                         {"alive", it != seen.end() && it->second.alive},
-                         {"reserved_by", it != seen.end() ? it->second.capability.reserved_by().to_string() : ""},
-                         {"restarts", store ? store->count_events(process_of(cell, id), "restarted") : 0},
-                         {"stock", stock}});
+    resources.push_back(resource);
   }
   return {{"inventory", inventory},
           {"orders", orders},

@@ -1,0 +1,192 @@
+#include "deploy/cellctl/dashboard.hpp"
+
+#include <openssl/crypto.h>
+#include <openssl/rand.h>
+
+#include <atomic>
+#include <iostream>
+#include <thread>
+
+#include <httplib.h>
+
+#include "deploy/cellctl/dashboard_assets.hpp"
+#include "deploy/cellctl/dashboard_feed.hpp"
+#include "twin/report/viewer/viewer_assets.hpp"
+
+namespace cellctl {
+namespace {
+
+constexpr const char* kCookie = "cell_token";
+
+std::string new_token() {
+  unsigned char bytes[24];
+  if (RAND_bytes(bytes, sizeof bytes) != 1) throw std::runtime_error("no random bytes for the dashboard's token");
+  static const char* hex = "0123456789abcdef";
+  std::string token;
+  for (unsigned char b : bytes) {
+    token += hex[b >> 4];
+    token += hex[b & 15];
+  }
+  return token;
+}
+
+bool same(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && CRYPTO_memcmp(a.data(), b.data(), a.size()) == 0;
+}
+
+// The token a request carries: `Authorization: Bearer T` or the cookie.
+std::string token_of(const httplib::Request& req) {
+  const std::string auth = req.get_header_value("Authorization");
+  if (auth.rfind("Bearer ", 0) == 0) return auth.substr(7);
+  const std::string cookies = req.get_header_value("Cookie");
+  const std::string key = std::string(kCookie) + "=";
+  for (std::size_t at = cookies.find(key); at != std::string::npos; at = cookies.find(key, at + 1)) {
+    if (at == 0 || cookies[at - 1] == ' ' || cookies[at - 1] == ';') {
+      const std::size_t end = cookies.find(';', at);
+      return cookies.substr(at + key.size(), end == std::string::npos ? std::string::npos : end - at - key.size());
+    }
+  }
+  return "";
+}
+
+// One server-sent event: `data:` lines may not hold a line break, and JSON text has none.
+std::string event(const char* name, const std::string& data) {
+  return std::string("event: ") + name + "\ndata: " + data + "\n\n";
+}
+
+}  // namespace
+
+struct Dashboard::Impl {
+  Impl(const CellConfig& cell, const CellObserver& observer) : feed(cell, observer), token(new_token()) {}
+
+  DashboardFeed feed;
+  std::string token;
+  std::string host;
+  int port = 0;
+  httplib::Server server;
+  std::atomic<int> followers{0};
+  std::atomic<bool> stopping{false};
+  std::thread thread;
+
+  bool allowed(const httplib::Request& req, httplib::Response& res) const {
+    if (same(token_of(req), token)) return true;
+    res.status = 401;
+    res.set_content("This cell's dashboard needs the operator token that cellctl up printed: open the address it gave, "
+                    "with ?token=...\n",
+                    "text/plain");
+    return false;
+  }
+
+  void serve_page(const httplib::Request& req, httplib::Response& res) const {
+    if (req.has_param("token")) {
+      if (!same(req.get_param_value("token"), token)) {
+        res.status = 401;
+        res.set_content("wrong token\n", "text/plain");
+        return;
+      }
+      // Out of the address bar and the history: the cookie carries it from now on.
+      res.set_header("Set-Cookie", std::string(kCookie) + "=" + token + "; Path=/; HttpOnly; SameSite=Strict");
+      res.set_redirect("/");
+      return;
+    }
+    if (!allowed(req, res)) return;
+    res.set_content(std::string(dashboard::page_html()), "text/html; charset=utf-8");
+  }
+
+  void follow(httplib::Response& res) {
+    if (++followers > kMaxFollowers) {
+      --followers;
+      res.status = 503;
+      res.set_content("too many pages follow this cell (at most " + std::to_string(kMaxFollowers) + ")\n", "text/plain");
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    // The first event holds the state and every bar kept; then each newer state, its new bars.
+    auto seen = std::make_shared<std::uint64_t>(0);
+    auto bars_seen = std::make_shared<std::uint64_t>(0);
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [this, seen, bars_seen](std::size_t, httplib::DataSink& sink) {
+          if (stopping) return false;
+          const DashboardFeed::State state = feed.wait_newer(*seen, std::chrono::seconds(10));
+          std::string out;
+          for (const auto& [seq, bar] : feed.bars_after(*bars_seen)) {
+            out += event("bar", bar);
+            *bars_seen = seq;
+          }
+          if (state.seq > *seen) {
+            out += event("state", state.json);
+            *seen = state.seq;
+          }
+          if (out.empty()) out = ": still here\n\n";  // a comment: a dead connection shows at the write
+          return !stopping && sink.write(out.data(), out.size());
+        },
+        [this](bool) { --followers; });
+  }
+};
+
+Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, const CellObserver& observer)
+    : impl_(std::make_unique<Impl>(cell, observer)) {
+  Impl& d = *impl_;
+  d.host = address.host;
+  auto& s = d.server;
+  s.new_task_queue = [] { return new httplib::ThreadPool(kMaxFollowers + kOtherThreads); };
+  s.set_payload_max_length(64 * 1024);
+  s.set_read_timeout(kReadTimeout.count(), 0);
+  s.set_write_timeout(kWriteTimeout.count(), 0);
+  s.set_keep_alive_max_count(20);
+  s.set_default_headers({{"Content-Security-Policy",
+                          "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
+                          "img-src 'self' data:; frame-ancestors 'none'; base-uri 'none'; form-action 'self'"},
+                         {"X-Content-Type-Options", "nosniff"},
+                         {"Referrer-Policy", "no-referrer"}});
+  s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
+    res.status = 500;
+    res.set_content("the dashboard could not answer this request\n", "text/plain");
+  });
+  s.Get("/", [&d](const httplib::Request& req, httplib::Response& res) { d.serve_page(req, res); });
+  // The page's own script and style: no cell data in them, served to anyone (the policy
+  // allows scripts from here only).
+  s.Get("/dashboard.js", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(dashboard::script_js()), "text/javascript; charset=utf-8");
+  });
+  s.Get("/three.js", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(twin::viewer::three_js()), "text/javascript; charset=utf-8");
+  });
+  s.Get("/dashboard.css", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(dashboard::style_css()), "text/css; charset=utf-8");
+  });
+  s.Get("/state", [&d](const httplib::Request& req, httplib::Response& res) {
+    if (!d.allowed(req, res)) return;
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(d.feed.wait_newer(0, std::chrono::seconds(2)).json, "application/json");
+  });
+  s.Get("/events", [&d](const httplib::Request& req, httplib::Response& res) {
+    if (d.allowed(req, res)) d.follow(res);
+  });
+  if (address.port == 0 ? (d.port = s.bind_to_any_port(address.host)) <= 0
+                        : !s.bind_to_port(address.host, address.port)) {
+    throw std::runtime_error("the dashboard cannot listen on " + address.host + ":" + std::to_string(address.port) +
+                             " (taken, or not an address of this host); choose another with --dashboard or `dashboard:`");
+  }
+  if (address.port != 0) d.port = address.port;
+  d.thread = std::thread([&d] { d.server.listen_after_bind(); });
+}
+
+Dashboard::~Dashboard() {
+  impl_->stopping = true;
+  impl_->feed.stop();  // wakes the pages' waits
+  impl_->server.stop();
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+int Dashboard::port() const { return impl_->port; }
+
+const std::string& Dashboard::token() const { return impl_->token; }
+
+std::string Dashboard::url() const {
+  const std::string host = impl_->host == "0.0.0.0" ? "127.0.0.1" : impl_->host;
+  return "http://" + host + ":" + std::to_string(impl_->port) + "/?token=" + impl_->token;
+}
+
+}  // namespace cellctl

@@ -1,0 +1,206 @@
+// The cell's dashboard page (deploy/cellctl/dashboard.hpp): follows the cell by server-sent
+// events and draws it. Every text that comes from the cell is set as text, never as markup.
+"use strict";
+(function () {
+  // What the page saw, for whoever checks it: each resource's states in turn ("idle", "gone"...).
+  const page = (window.dashboard = { states: 0, latencies: [], bars: [], state: null, seen: {} });
+  let receivedAt = 0; // wall s when the last state came
+  let lastHeard = 0;
+
+  function el(tag, text, cls) {
+    const e = document.createElement(tag);
+    if (text !== undefined && text !== null) e.textContent = String(text);
+    if (cls) e.className = cls;
+    return e;
+  }
+  function fill(tbody, rows) {
+    tbody.replaceChildren(...rows.map((cells) => {
+      const tr = el("tr");
+      for (const c of cells) tr.append(c instanceof Node ? wrap(c) : el("td", c));
+      return tr;
+    }));
+  }
+  function wrap(node) {
+    const td = el("td");
+    td.append(node);
+    return td;
+  }
+  function simNow() {
+    const s = page.state;
+    if (!s) return 0;
+    return s.sim_time + (Date.now() / 1000 - receivedAt) * (s.real_time_factor || 1);
+  }
+  function hue(text) {
+    let h = 0;
+    for (const c of String(text)) h = (h * 31 + c.charCodeAt(0)) % 360;
+    return h;
+  }
+
+  function renderResources(resources) {
+    fill(document.querySelector("#resources tbody"), resources.map((r) => {
+      const word = !r.alive ? "gone" : r.busy ? "busy" : "idle";
+      const seen = (page.seen[r.id] = page.seen[r.id] || []);
+      if (seen[seen.length - 1] !== word) seen.push(word);
+      const ago = r.restarted_at ? Date.now() / 1000 - r.restarted_at : Infinity;
+      const state = el("span", word + (r.alive && ago < 60 ? ", restarted " + Math.round(ago) + " s ago" : ""),
+                       r.alive && ago < 60 ? "back" : word);
+      const doing = r.current ? r.current.operation + (r.current.part ? " " + r.current.part : "") + " (" + r.current.order + ")" : "";
+      const stock = Object.entries(r.stock || {}).map(([t, n]) => t + " " + n).join(", ");
+      const refused = r.refused ? r.refused + (r.last_refusal ? ": " + r.last_refusal : "") : "";
+      return [r.id, r.kind || "", state, doing, r.reserved_by || "", (r.waiting || []).join(", "), r.queued ?? "", refused,
+              r.restarts || 0, stock];
+    }));
+  }
+  function renderOrders(orders) {
+    fill(document.querySelector("#orders tbody"), orders.map((o) => {
+      const bar = el("progress");
+      bar.max = 1;
+      bar.value = o.state === "DONE" ? 1 : o.progress || 0;
+      return [o.order + (o.quote ? " (quote)" : ""), el("span", o.state, "state-" + o.state), bar, o.place ?? "",
+              o.message || "", o.reason || ""];
+    }));
+  }
+  function renderInventory(inventory) {
+    fill(document.querySelector("#inventory tbody"), Object.entries(inventory).map(([type, c]) => [
+      type, c.initial, c.in_buffers, c.in_transit, c.on_stations, c.assembled, c.inspection,
+      el("span", c.conserved ? "yes" : "NO", c.conserved ? "idle" : "gone")]));
+  }
+  function renderAlarms(alarms) {
+    document.getElementById("alarms").replaceChildren(...alarms.map((a) => el("li",
+      new Date(a.time * 1000).toLocaleTimeString() + "  " + a.source + " " + a.event + (a.order ? " [" + a.order + "]" : "") +
+      (a.detail ? ": " + a.detail : ""))));
+  }
+  function renderAttention(items) {
+    const list = document.getElementById("attention");
+    if (!items.length) list.replaceChildren(el("li", "nothing", "calm"));
+    else list.replaceChildren(...items.map((a) => el("li", a.what, a.severity)));
+  }
+
+  // The Gantt chart: a row per resource, the last hour of sim time, bars coloured by order.
+  function renderGantt() {
+    const s = page.state;
+    const canvas = document.getElementById("gantt");
+    if (!s) return;
+    const rows = s.resources.map((r) => r.id);
+    const rowHeight = 18, left = 120, width = Math.max(600, canvas.parentElement.clientWidth - 4);
+    canvas.width = width;
+    canvas.height = rows.length * rowHeight + 20;
+    const g = canvas.getContext("2d");
+    g.clearRect(0, 0, canvas.width, canvas.height);
+    // The last hour, or less while the cell has worked less: its work fills the chart.
+    const now = simNow();
+    const first = page.bars.length ? page.bars[0].start : now;
+    const span = Math.min(3600, Math.max(120, (now - first) * 1.05));
+    const from = now - span;
+    const x = (t) => left + ((t - from) / span) * (width - left);
+    g.font = "11px sans-serif";
+    rows.forEach((id, i) => {
+      g.fillStyle = "#1d2430";
+      g.fillText(id, 4, i * rowHeight + 13);
+      g.fillStyle = "#e3e6ea";
+      g.fillRect(left, i * rowHeight + rowHeight - 1, width - left, 1);
+    });
+    const draw = (resource, order, start, end, failed) => {
+      const i = rows.indexOf(resource);
+      if (i < 0 || end < from) return;
+      g.fillStyle = failed ? "#b00020" : "hsl(" + hue(order) + ",60%,55%)";
+      g.fillRect(x(Math.max(start, from)), i * rowHeight + 3, Math.max(1, x(end) - x(Math.max(start, from))), rowHeight - 6);
+    };
+    for (const b of page.bars) draw(b.resource, b.order, b.start, b.end, b.state !== "succeeded");
+    for (const r of s.resources) if (r.current) draw(r.id, r.current.order, r.current.since, now, false);
+    g.fillStyle = "#555";
+    const step = span > 1200 ? 600 : span > 300 ? 60 : 30;
+    for (let t = now; t >= from; t -= step) {
+      g.fillText(Math.round((t - now) / 60 * 10) / 10 + " min", x(t) - 14, canvas.height - 4);
+    }
+  }
+
+  // The cell in 3D: tables, buffers and robots where their capabilities place them.
+  const scene = { ready: false };
+  function startScene() {
+    const box = document.getElementById("scene");
+    if (!window.THREE) return;
+    try {
+      scene.renderer = new THREE.WebGLRenderer({ antialias: true });
+    } catch (e) {
+      box.textContent = "no 3D view here: " + e.message;
+      return;
+    }
+    scene.renderer.setSize(box.clientWidth, box.clientHeight);
+    box.append(scene.renderer.domElement);
+    scene.three = new THREE.Scene();
+    scene.three.background = new THREE.Color(0xeef1f5);
+    scene.three.add(new THREE.HemisphereLight(0xffffff, 0x8899aa, 1.0));
+    const floor = new THREE.GridHelper(10, 20, 0x99a3ad, 0xd0d6dc);
+    scene.three.add(floor);
+    scene.camera = new THREE.PerspectiveCamera(45, box.clientWidth / box.clientHeight, 0.1, 100);
+    scene.camera.position.set(5, 6, 8);
+    scene.camera.lookAt(0.8, 0, 1.2);
+    scene.meshes = new Map();
+    scene.ready = true;
+  }
+  const shapes = {
+    station: () => new THREE.BoxGeometry(1.0, 0.05, 1.0),
+    buffer: () => new THREE.BoxGeometry(0.4, 0.3, 0.4),
+    "mobile-robot": () => new THREE.CylinderGeometry(0.25, 0.25, 0.3, 24),
+    arm: () => new THREE.CylinderGeometry(0.05, 0.07, 0.5, 12),
+  };
+  function renderScene(resources) {
+    if (!scene.ready) return;
+    for (const r of resources) {
+      if (!r.position || !shapes[r.kind]) continue;
+      let mesh = scene.meshes.get(r.id);
+      if (!mesh) {
+        mesh = new THREE.Mesh(shapes[r.kind](), new THREE.MeshLambertMaterial());
+        scene.meshes.set(r.id, mesh);
+        scene.three.add(mesh);
+      }
+      const lift = r.kind === "arm" ? 0.25 : r.kind === "station" ? -0.025 : 0.15;
+      mesh.position.set(r.position[0], r.position[1] + lift, r.position[2]);
+      mesh.material.color.set(!r.alive ? 0xb00020 : r.busy ? 0x0b5cad : r.kind === "station" ? 0x9aa5b1 : 0x2e7d32);
+    }
+    scene.renderer.render(scene.three, scene.camera);
+    document.body.dataset.scene = "drawn";
+  }
+
+  function render(s) {
+    document.getElementById("domain").textContent = "on domain " + s.domain;
+    renderAttention(s.attention);
+    renderResources(s.resources);
+    renderOrders(s.orders);
+    renderInventory(s.inventory);
+    renderAlarms(s.alarms);
+    renderGantt();
+    renderScene(s.resources);
+  }
+
+  function follow() {
+    const events = new EventSource("/events");
+    const link = document.getElementById("link");
+    events.onopen = () => { link.textContent = "live"; link.className = "link-up"; };
+    events.onerror = () => { link.textContent = "reconnecting"; link.className = "link-down"; };
+    events.addEventListener("bar", (e) => {
+      page.bars.push(JSON.parse(e.data));
+      if (page.bars.length > 20000) page.bars.splice(0, page.bars.length - 20000);
+    });
+    events.addEventListener("state", (e) => {
+      const s = JSON.parse(e.data);
+      receivedAt = Date.now() / 1000;
+      if (s.heard_at > lastHeard) {
+        if (lastHeard > 0) page.latencies.push(receivedAt - s.heard_at);
+        lastHeard = s.heard_at;
+      }
+      page.state = s;
+      page.states += 1;
+      render(s);
+    });
+  }
+
+  startScene();
+  follow();
+  setInterval(() => {
+    if (!page.state) return;
+    document.getElementById("clock").textContent = "sim " + simNow().toFixed(1) + " s";
+    renderGantt();
+  }, 1000);
+})();

@@ -1,0 +1,148 @@
+// The cell's dashboard in Debian's headless chromium, as an operator would use it: starts
+// `cellctl up --dashboard` on a domain of its own, opens the address it printed, and checks
+// what a person would see: every resource of the cell; an order (submitted with cellctl)
+// advancing to DONE; a killed buffer turning gone, then back; no console error; no request
+// to anything but the dashboard. Prints the page's update latency (a DDS event heard by
+// cellctl up to the page's state, p50 and p99) and can keep a screenshot.
+//   node check_dashboard.js CELLCTL CELL.yaml DOMAIN PRODUCT.aml [SCREENSHOT.png]
+// Exit 0: all good; 1: a check failed; 77: no chromium or puppeteer-core here (skipped).
+"use strict";
+const fs = require("fs");
+const os = require("os");
+const path = require("path");
+const { spawn, spawnSync } = require("child_process");
+
+const chromium = process.env.CHROMIUM || "/usr/bin/chromium";
+let puppeteer;
+try {
+  puppeteer = require("puppeteer-core");
+} catch (e) {
+  console.log("skipped: npm ci --prefix tests/browser has not run (" + e.message + ")");
+  process.exit(77);
+}
+if (!fs.existsSync(chromium)) {
+  console.log("skipped: no chromium at " + chromium);
+  process.exit(77);
+}
+const [cellctl, cellFile, domain, product, screenshot] = process.argv.slice(2);
+const scratch = fs.mkdtempSync(path.join(os.tmpdir(), "dashboard-"));
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// Waits until `text` is in the file; what matched `pattern` in it.
+async function appears(file, pattern, seconds) {
+  for (let waited = 0; waited < seconds * 10; ++waited) {
+    const text = fs.existsSync(file) ? fs.readFileSync(file, "utf8") : "";
+    const m = text.match(pattern);
+    if (m) return m;
+    await sleep(100);
+  }
+  throw new Error(path.basename(file) + " never said " + pattern + " (" + seconds + " s)");
+}
+
+// The pid of the cell's process whose command line has `--id ID` on our domain.
+function processOf(id) {
+  for (const name of fs.readdirSync("/proc")) {
+    if (!/^\d+$/.test(name)) continue;
+    let args;
+    try {
+      args = fs.readFileSync("/proc/" + name + "/cmdline", "utf8").split("\0");
+    } catch (e) {
+      continue;
+    }
+    const at = (flag) => args.indexOf(flag);
+    if (at("--id") >= 0 && args[at("--id") + 1] === id && args[at("--domain") + 1] === domain) return Number(name);
+  }
+  return 0;
+}
+
+function percentile(values, p) {
+  const sorted = [...values].sort((a, b) => a - b);
+  return sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
+}
+
+(async () => {
+  const problems = [];
+  const upLog = path.join(scratch, "up.log");
+  const up = spawn(cellctl, ["up", cellFile, "--domain", domain, "--state-dir", path.join(scratch, "state"),
+                             "--dashboard", "127.0.0.1:0"], { stdio: ["ignore", fs.openSync(upLog, "w"), fs.openSync(upLog, "a")] });
+  let browser;
+  try {
+    const url = (await appears(upLog, /dashboard: (http:\/\/127\.0\.0\.1:\d+\/\?token=[0-9a-f]+)/, 30))[1];
+    await appears(upLog, /cell up on domain/, 90);
+    const origin = new URL(url).origin;
+
+    browser = await puppeteer.launch({
+      executablePath: chromium,
+      headless: true,
+      args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-sandbox"],
+    });
+    const page = await browser.newPage();
+    await page.setViewport({ width: 1400, height: 1100 });
+    page.on("console", (m) => { if (m.type() === "error") problems.push("console error: " + m.text()); });
+    page.on("pageerror", (e) => problems.push("page error: " + e.message));
+    page.on("request", (r) => {
+      if (!r.url().startsWith(origin + "/") && !r.url().startsWith("data:")) problems.push("requested " + r.url());
+    });
+    await page.goto(url, { waitUntil: "load" });
+    if (page.url() !== origin + "/") problems.push("the token stayed in the address: " + page.url());
+
+    // Every resource of the cell, as cellctl status lists them.
+    const status = JSON.parse(spawnSync(cellctl, ["status", "--cell", cellFile, "--domain", domain, "--json"],
+                                        { encoding: "utf8" }).stdout);
+    const ids = status.resources.map((r) => r.id);
+    await page.waitForFunction((ids) => {
+      const shown = [...document.querySelectorAll("#resources tbody tr")].map((tr) => tr.cells[0].textContent);
+      return ids.every((id) => shown.includes(id));
+    }, { timeout: 20000 }, ids).catch(() => problems.push("the page does not show every resource: " + ids.join(", ")));
+
+    // An order to its end.
+    const submit = spawn(cellctl, ["submit", product, "--domain", domain, "--order", "dash-1", "--out",
+                                   path.join(scratch, "dash-1")], { stdio: "ignore" });
+    await page.waitForFunction(() => [...document.querySelectorAll("#orders tbody tr")].some(
+      (tr) => tr.cells[0].textContent === "dash-1" && tr.cells[1].textContent === "DONE"), { timeout: 150000 })
+      .catch(() => problems.push("order dash-1 never showed DONE"));
+    submit.kill("SIGTERM");
+    const bars = await page.evaluate(() => window.dashboard.bars.filter((b) => b.order === "dash-1").length);
+    if (bars < 5) problems.push("the Gantt chart holds " + bars + " bars of dash-1's work");
+
+    // A killed buffer: gone, then back.
+    const buffer = ids.find((id) => id.startsWith("buffer"));
+    const pid = processOf(buffer);
+    if (!pid) {
+      problems.push("no process of " + buffer + " found");
+    } else {
+      process.kill(pid, "SIGKILL");
+      await page.waitForFunction((id) => {
+        const seen = window.dashboard.seen[id] || [];
+        const gone = seen.lastIndexOf("gone");
+        return gone >= 0 && seen.slice(gone + 1).some((s) => s !== "gone");
+      }, { timeout: 60000 }, buffer).catch(async () => problems.push(
+        buffer + " did not turn gone and back: it went " + JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], buffer))));
+      const alarms = await page.$$eval("#alarms li", (lis) => lis.map((li) => li.textContent));
+      if (!alarms.some((a) => a.includes(buffer) && a.includes("restarted"))) problems.push("no alarm says " + buffer + " restarted");
+    }
+    const drawn = await page.evaluate(() => document.body.dataset.scene);
+    if (drawn !== "drawn") problems.push("the 3D view was not drawn");
+
+    const latencies = await page.evaluate(() => window.dashboard.latencies);
+    if (latencies.length) {
+      console.log("update latency, DDS event heard to page: p50 " + (1000 * percentile(latencies, 0.5)).toFixed(1) +
+                  " ms, p99 " + (1000 * percentile(latencies, 0.99)).toFixed(1) + " ms over " + latencies.length + " updates");
+    } else {
+      problems.push("no update reached the page");
+    }
+    if (screenshot) await page.screenshot({ path: screenshot, fullPage: true });
+  } catch (e) {
+    problems.push(e.message);
+  } finally {
+    if (browser) await browser.close();
+    spawnSync(cellctl, ["down", "--domain", domain], { timeout: 30000 });
+    for (let i = 0; i < 100 && up.exitCode === null; ++i) await sleep(100);
+    if (up.exitCode === null) up.kill("SIGKILL");
+  }
+  problems.forEach((p) => console.log("dashboard: " + p));
+  if (problems.length) console.log(fs.readFileSync(upLog, "utf8").split("\n").slice(-30).join("\n"));
+  fs.rmSync(scratch, { recursive: true, force: true });
+  console.log(problems.length ? "the dashboard failed" : "the dashboard passed");
+  process.exit(problems.length ? 1 : 0);
+})();
