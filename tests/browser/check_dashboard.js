@@ -3,7 +3,7 @@
 // what a person would see: every resource of the cell; an order (submitted with cellctl)
 // advancing to DONE; a killed buffer turning gone, then back; no console error; no request
 // to anything but the dashboard. Prints the page's update latency (a DDS event heard by
-// cellctl up to the page's state, p50 and p99) and can keep a screenshot.
+// cellctl up to the page's state, p50 and p99) and can keep a screenshot of the page at work.
 //   node check_dashboard.js CELLCTL CELL.yaml DOMAIN PRODUCT.aml [SCREENSHOT.png]
 // Exit 0: all good; 1: a check failed; 77: no chromium or puppeteer-core here (skipped).
 "use strict";
@@ -98,8 +98,13 @@ function percentile(values, p) {
     // An order to its end.
     const submit = spawn(cellctl, ["submit", product, "--domain", domain, "--order", "dash-1", "--out",
                                    path.join(scratch, "dash-1")], { stdio: "ignore" });
-    await page.waitForFunction(() => [...document.querySelectorAll("#orders tbody tr")].some(
-      (tr) => tr.cells[0].textContent === "dash-1" && tr.cells[1].textContent === "DONE"), { timeout: 150000 })
+    const shows = (state) => page.waitForFunction((state) => [...document.querySelectorAll("#orders tbody tr")].some(
+      (tr) => tr.cells[0].textContent === "dash-1" && tr.cells[1].textContent === state), { timeout: 150000 }, state);
+    if (screenshot) {  // the page at work
+      await shows("PHYSICAL_ASSEMBLY").then(() => sleep(800)).then(() => page.screenshot({ path: screenshot, fullPage: true }))
+        .catch(() => console.log("no screenshot: dash-1 was not seen in PHYSICAL_ASSEMBLY"));
+    }
+    await shows("DONE")
       .catch(() => problems.push("order dash-1 never showed DONE"));
     submit.kill("SIGTERM");
     const bars = await page.evaluate(() => window.dashboard.bars.filter((b) => b.order === "dash-1").length);
@@ -131,7 +136,6 @@ function percentile(values, p) {
     } else {
       problems.push("no update reached the page");
     }
-    if (screenshot) await page.screenshot({ path: screenshot, fullPage: true });
   } catch (e) {
     problems.push(e.message);
   } finally {

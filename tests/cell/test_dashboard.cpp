@@ -117,6 +117,10 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
     }
     CHECK(state["domain"] == 175);
     CHECK(state["attention"].empty());
+
+    r = client.Post("/state", {{"Authorization", "Bearer " + token}}, std::string(100 * 1024, 'x'), "text/plain");
+    REQUIRE(r);
+    CHECK(r->status == 413);  // past 64 kB: refused, not read
   }
 
   SECTION("past the bound of pages following the cell, one more is refused; stalled connections do not stop it") {

@@ -45,7 +45,9 @@
       const state = el("span", word + (r.alive && ago < 60 ? ", restarted " + Math.round(ago) + " s ago" : ""),
                        r.alive && ago < 60 ? "back" : word);
       const doing = r.current ? r.current.operation + (r.current.part ? " " + r.current.part : "") + " (" + r.current.order + ")" : "";
-      const stock = Object.entries(r.stock || {}).map(([t, n]) => t + " " + n).join(", ");
+      const types = Object.entries(r.stock || {});
+      const stock = el("span", types.length ? types.reduce((sum, [, n]) => sum + n, 0) + " parts of " + types.length + " types" : "");
+      stock.title = types.map(([t, n]) => t + " " + n).join(", ");
       const refused = r.refused ? r.refused + (r.last_refusal ? ": " + r.last_refusal : "") : "";
       return [r.id, r.kind || "", state, doing, r.reserved_by || "", (r.waiting || []).join(", "), r.queued ?? "", refused,
               r.restarts || 0, stock];
