@@ -229,6 +229,7 @@ void DashboardFeed::build() {
   last_content_ = std::move(content);
   // When the page shows it, it knows how old the change is (docs/performance.md).
   status["heard_at"] = unix_seconds(observer_.changed_at());
+  status["built_at"] = unix_seconds(std::chrono::system_clock::now());
   status["sim_time"] = observer_.sim_now();
   {
     std::lock_guard<std::mutex> lock(mutex_);

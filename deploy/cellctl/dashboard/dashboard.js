@@ -3,7 +3,7 @@
 "use strict";
 (function () {
   // What the page saw, for whoever checks it: each resource's states in turn ("idle", "gone"...).
-  const page = (window.dashboard = { states: 0, latencies: [], bars: [], state: null, seen: {} });
+  const page = (window.dashboard = { states: 0, latencies: [], built: [], received: [], bars: [], state: null, seen: {} });
   let receivedAt = 0; // wall s when the last state came
   let lastHeard = 0;
 
@@ -149,6 +149,10 @@
   };
   function renderScene(resources) {
     if (!scene.ready) return;
+    // Software rendering takes tens of ms: only when something in the view changed.
+    const key = JSON.stringify(resources.map((r) => [r.id, r.alive, r.busy, r.position]));
+    if (key === scene.key) return;
+    scene.key = key;
     for (const r of resources) {
       if (!r.position || !shapes[r.kind]) continue;
       let mesh = scene.meshes.get(r.id);
@@ -165,6 +169,15 @@
     document.body.dataset.scene = "drawn";
   }
 
+  // The tables at once; the chart and the 3D view, which take longer to draw, at most every
+  // quarter of a second (the newest state then).
+  let slowDrawn = 0, slowPending = false;
+  function drawSlow() {
+    slowPending = false;
+    slowDrawn = Date.now();
+    renderGantt();
+    renderScene(page.state.resources);
+  }
   function render(s) {
     document.getElementById("domain").textContent = "on domain " + s.domain;
     renderAttention(s.attention);
@@ -172,8 +185,9 @@
     renderOrders(s.orders);
     renderInventory(s.inventory);
     renderAlarms(s.alarms);
-    renderGantt();
-    renderScene(s.resources);
+    if (slowPending) return;
+    slowPending = true;
+    setTimeout(drawSlow, Math.max(0, slowDrawn + 250 - Date.now()));
   }
 
   function follow() {
@@ -185,16 +199,28 @@
       page.bars.push(JSON.parse(e.data));
       if (page.bars.length > 20000) page.bars.splice(0, page.bars.length - 20000);
     });
+    // States that come faster than the page draws are drawn once, the newest, at the next frame.
+    let drawing = false;
     events.addEventListener("state", (e) => {
-      const s = JSON.parse(e.data);
-      receivedAt = Date.now() / 1000;
-      if (s.heard_at > lastHeard) {
-        if (lastHeard > 0) page.latencies.push(receivedAt - s.heard_at);
-        lastHeard = s.heard_at;
-      }
-      page.state = s;
+      page.state = JSON.parse(e.data);
       page.states += 1;
-      render(s);
+      receivedAt = Date.now() / 1000;
+      if (page.state.heard_at > lastHeard && lastHeard > 0) page.received.push(receivedAt - page.state.heard_at);
+      if (drawing) return;
+      drawing = true;
+      requestAnimationFrame(() => {
+        drawing = false;
+        const s = page.state;
+        render(s);
+        // How old the change it shows is, once drawn (the first state's change may be old).
+        if (s.heard_at > lastHeard) {
+          if (lastHeard > 0) {
+            page.latencies.push(Date.now() / 1000 - s.heard_at);
+            page.built.push(s.built_at - s.heard_at);  // of which cellctl up's part
+          }
+          lastHeard = s.heard_at;
+        }
+      });
     });
   }
 
