@@ -129,11 +129,6 @@ std::map<std::string, cell::OrderStatus> CellObserver::orders() const {
 
 double CellObserver::sim_now() const { return impl_->clock->now(); }
 
-std::uint64_t CellObserver::version() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return version_;
-}
-
 void CellObserver::note_change() {
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "capabilities.h"
-#include "commands.h"
+#include "deploy/cellctl/command_bars.hpp"
 #include "orders.h"
 #include "services/dds/participant.hpp"
 
@@ -26,16 +26,6 @@ struct ResourceView {
   cell::Capability capability;
   bool alive = true;
   std::chrono::system_clock::time_point heard_at;  // its last capability
-};
-
-// One command event as the observer heard it, for those that follow the cell's work.
-struct CommandHeard {
-  std::uint64_t seq = 0;  // 1, 2, ... in the order heard
-  std::string resource, order, operation, part, command;
-  cell::CommandState state = cell::ACCEPTED;
-  std::string reason;
-  double sim_time = 0;
-  std::chrono::system_clock::time_point heard_at;
 };
 
 class CellObserver {
@@ -58,11 +48,11 @@ class CellObserver {
   std::size_t events_logged() const;
   double sim_now() const;  // the cell's sim time, s (0 before cell-sim's clock is heard)
 
-  // Grows with every capability, order status and command event heard, and note_change().
-  std::uint64_t version() const;
-  // A change of the cell that DDS does not carry (a process ended: the journal says so).
+  // The cell's version grows with every capability, order status and command event heard,
+  // and with note_change(): a change DDS does not carry (a process ended: the journal says so).
   void note_change();
-  // Waits until version() passes `seen`; the version then (`seen` after the timeout).
+  // Waits until the version passes `seen` (0 at first); the version then (`seen` after the
+  // timeout).
   std::uint64_t wait_for_change(std::uint64_t seen, std::chrono::milliseconds timeout) const;
   // When the change that made the current version was heard.
   std::chrono::system_clock::time_point changed_at() const;

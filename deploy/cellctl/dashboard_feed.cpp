@@ -1,6 +1,5 @@
 #include "deploy/cellctl/dashboard_feed.hpp"
 
-#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <set>
@@ -74,6 +73,8 @@ void DashboardFeed::run() {
     } catch (const std::exception& e) {
       // The page shows the cell as last built; the cell goes on (a database busy a moment).
       std::cerr << "cellctl up: dashboard: " << e.what() << std::endl;
+    } catch (...) {
+      std::cerr << "cellctl up: dashboard: an unknown error building its state" << std::endl;
     }
   }
 }
@@ -84,43 +85,24 @@ void DashboardFeed::take_command_events(json& new_alarms) {
   events_seen_ = events.back().seq;
   std::vector<std::pair<std::string, double>> ended;  // bar, its end
   for (const CommandHeard& e : events) {
-    // A resource accepts a command and starts it at once when idle; a queued one starts at its
-    // first EXECUTING.
-    if (e.state == cell::ACCEPTED) {
-      const bool idle = std::none_of(running_.begin(), running_.end(),
-                                     [&](const auto& r) { return r.second.started && r.second.resource == e.resource; });
-      running_.try_emplace(e.command, Running{e.resource, e.order, e.operation, e.part, e.sim_time, idle});
-      continue;
-    }
-    if (e.state == cell::EXECUTING) {
-      auto [it, added] = running_.try_emplace(e.command, Running{e.resource, e.order, e.operation, e.part, e.sim_time, true});
-      if (!it->second.started) it->second = Running{e.resource, e.order, e.operation, e.part, e.sim_time, true};
-      continue;
-    }
-    const bool failed = e.state == cell::ABORTED || e.state == cell::REJECTED;
-    if (!failed && e.state != cell::SUCCEEDED && e.state != cell::CANCELED) continue;  // not its end
-    if (failed) {
+    if (e.state == cell::ABORTED || e.state == cell::REJECTED) {
       new_alarms.push_back({{"time", unix_seconds(e.heard_at)},
                             {"source", e.resource},
                             {"event", e.state == cell::REJECTED ? "refused" : "aborted"},
                             {"order", e.order},
                             {"detail", e.operation + (e.part.empty() ? "" : " " + e.part) + ": " + e.reason}});
     }
-    const auto it = running_.find(e.command);
-    if (it == running_.end() || !it->second.started) {  // never under way: no bar
-      if (it != running_.end()) running_.erase(it);
-      continue;
+    if (const auto bar = commands_.take(e)) {
+      ended.emplace_back(json{{"resource", bar->resource},
+                              {"order", bar->order},
+                              {"operation", bar->operation},
+                              {"part", bar->part},
+                              {"start", bar->start},
+                              {"end", bar->end},
+                              {"state", dds::state_name(bar->state)}}
+                             .dump(),
+                         bar->end);
     }
-    ended.emplace_back(json{{"resource", e.resource},
-                            {"order", e.order},
-                            {"operation", e.operation},
-                            {"part", e.part},
-                            {"start", it->second.since},
-                            {"end", e.sim_time},
-                            {"state", dds::state_name(e.state)}}
-                           .dump(),
-                       e.sim_time);
-    running_.erase(it);
   }
   std::lock_guard<std::mutex> lock(mutex_);
   for (auto& [bar, end] : ended) {
@@ -147,11 +129,7 @@ void DashboardFeed::take_journal(json& new_alarms) {
       for (const auto& id : cell_.resource_ids()) {
         if (all || process_of(cell_, id) == e.source) ended_at_[process_of(cell_, id)] = e.time;
       }
-      // Their commands under way ended with them, with no event.
-      for (auto it = running_.begin(); it != running_.end();) {
-        const bool lost = all || process_of(cell_, it->second.resource) == e.source;
-        it = lost ? running_.erase(it) : std::next(it);
-      }
+      commands_.lose([&](const std::string& resource) { return all || process_of(cell_, resource) == e.source; });
     }
     if (!is_alarm(e)) continue;
     new_alarms.push_back({{"time", e.time}, {"source", e.source}, {"event", e.event}, {"order", e.order}, {"detail", e.detail}});
@@ -194,10 +172,7 @@ void DashboardFeed::build() {
   while (alarms_.size() > kKeptAlarms) alarms_.pop_back();
 
   json status = cell_status(cell_, observer_, store_.get());
-  std::map<std::string, const Running*> under_way;  // resource ->
-  for (const auto& [command, r] : running_) {
-    if (r.started) under_way[r.resource] = &r;
-  }
+  const auto under_way = commands_.under_way();
   const auto heard = observer_.resources();
   for (auto& r : status["resources"]) {
     const std::string id = r["id"];
@@ -211,10 +186,10 @@ void DashboardFeed::build() {
     }
     const auto it = under_way.find(id);
     if (it == under_way.end()) continue;
-    r["current"] = {{"operation", it->second->operation},
-                    {"order", it->second->order},
-                    {"part", it->second->part},
-                    {"since", it->second->since}};
+    r["current"] = {{"operation", it->second.operation},
+                    {"order", it->second.order},
+                    {"part", it->second.part},
+                    {"since", it->second.since}};
   }
   status.erase("state_dir");
   status["attention"] = attention(status);

@@ -25,6 +25,7 @@
 
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
+#include "deploy/cellctl/command_bars.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -54,11 +55,6 @@ class DashboardFeed {
   void stop();
 
  private:
-  struct Running {  // a command under way
-    std::string resource, order, operation, part;
-    double since = 0;      // sim s: accepted, or started
-    bool started = false;  // false: queued behind another
-  };
   void run();
   void build();
   void take_command_events(nlohmann::json& new_alarms);
@@ -71,7 +67,7 @@ class DashboardFeed {
   // The build thread's own.
   std::uint64_t events_seen_ = 0;
   long journal_seen_ = 0;
-  std::map<std::string, Running> running_;  // command id ->
+  CommandBars commands_;
   // Process -> when it last ended (Unix s). DDS still takes a killed resource for alive until
   // its lease runs out, and a restart within the lease never shows there: a resource is gone
   // from its process's end until its new process is heard.

@@ -104,3 +104,17 @@ TEST_CASE("every shipped cell fits a host of 2 cores and 8 GB with its max_twins
     CHECK(cellctl::limit_problems(cell, processes, static_cast<std::size_t>(cell.max_twins), {8192, 4096, 1024}).empty());
   }
 }
+
+TEST_CASE("deployment: dashboard is [ADDR:]PORT, loopback unless ADDR says, none by default", "[cellctl][config]") {
+  CHECK(cell_with("").dashboard.empty());
+  CHECK(cell_with("dashboard: 8080\n").dashboard == "8080");
+  const auto loopback = cellctl::parse_dashboard_address("8080");
+  CHECK(loopback.host == "127.0.0.1");
+  CHECK(loopback.port == 8080);
+  const auto any = cellctl::parse_dashboard_address("0.0.0.0:0");
+  CHECK(any.host == "0.0.0.0");
+  CHECK(any.port == 0);
+  CHECK_THROWS_WITH(cell_with("dashboard: 70000\n"), Catch::Contains(":2: dashboard: '70000' is not [ADDR:]PORT"));
+  CHECK_THROWS_WITH(cell_with("dashboard: web\n"), Catch::Contains(":2"));
+  CHECK_THROWS_AS(cellctl::parse_dashboard_address(":8080"), cellctl::ConfigError);
+}
