@@ -4,6 +4,8 @@
 #include <openssl/rand.h>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -11,6 +13,7 @@
 
 #include "deploy/cellctl/dashboard_assets.hpp"
 #include "deploy/cellctl/dashboard_feed.hpp"
+#include "services/state/cell_store.hpp"
 #include "twin/report/viewer/viewer_assets.hpp"
 
 namespace cellctl {
@@ -57,8 +60,9 @@ std::string event(const char* name, const std::string& data) {
 }  // namespace
 
 struct Dashboard::Impl {
-  Impl(const CellConfig& cell, const CellObserver& observer) : feed(cell, observer), token(new_token()) {}
+  Impl(const CellConfig& cell, const CellObserver& observer) : cell(cell), feed(cell, observer), token(new_token()) {}
 
+  const CellConfig& cell;
   DashboardFeed feed;
   std::string token;
   std::string host;
@@ -91,6 +95,44 @@ struct Dashboard::Impl {
     }
     if (!allowed(req, res)) return;
     res.set_content(std::string(dashboard::page_html()), "text/html; charset=utf-8");
+  }
+
+  // An order's report, plan or animation, from the folder its twin wrote them to.
+  void serve_result(const std::string& order, const std::string& file, httplib::Response& res) const {
+    std::string out;
+    for (const auto& o : state::CellStore(cell.state_folder()).orders()) {
+      if (o.order == order) out = o.out;
+    }
+    const std::filesystem::path path = std::filesystem::path(out) / file;
+    std::error_code error;
+    const auto size = out.empty() ? 0 : std::filesystem::file_size(path, error);
+    if (out.empty() || error) {
+      res.status = 404;
+      res.set_content("order " + order + " has no " + file + (out.empty() ? " (no such order)" : " (yet)") + "\n",
+                      "text/plain");
+      return;
+    }
+    if (size > kMaxResultBytes) {
+      res.status = 413;
+      res.set_content(file + " of order " + order + " is larger than the dashboard serves: read it from " + path.string() + "\n",
+                      "text/plain");
+      return;
+    }
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes(size, '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(size));
+    if (file == "report.html") {
+      // The report runs its own inline viewer, sandboxed: an origin of its own, no access to
+      // the dashboard's. Its policy replaces the page's (two would both apply).
+      res.headers.erase("Content-Security-Policy");
+      res.set_header("Content-Security-Policy",
+                     "sandbox allow-scripts; default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; "
+                     "img-src data: blob:; connect-src data: blob:");
+      res.set_content(std::move(bytes), "text/html; charset=utf-8");
+    } else {
+      res.set_header("Content-Disposition", "attachment; filename=\"" + order + "-" + file + "\"");
+      res.set_content(std::move(bytes), file == "plan.json" ? "application/json" : "model/gltf+json");
+    }
   }
 
   void follow(httplib::Response& res) {
@@ -164,6 +206,10 @@ Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, co
   s.Get("/events", [&d](const httplib::Request& req, httplib::Response& res) {
     if (d.allowed(req, res)) d.follow(res);
   });
+  s.Get(R"(/orders/([A-Za-z0-9_.-]{1,128})/(report\.html|plan\.json|animation\.gltf))",
+        [&d](const httplib::Request& req, httplib::Response& res) {
+          if (d.allowed(req, res)) d.serve_result(req.matches[1], req.matches[2], res);
+        });
   if (address.port == 0 ? (d.port = s.bind_to_any_port(address.host)) <= 0
                         : !s.bind_to_port(address.host, address.port)) {
     throw std::runtime_error("the dashboard cannot listen on " + address.host + ":" + std::to_string(address.port) +

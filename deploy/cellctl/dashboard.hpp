@@ -2,7 +2,8 @@
 // The cell's live dashboard, served by `cellctl up --dashboard [ADDR:]PORT` (or the
 // deployment file's `dashboard:`): one page (deploy/cellctl/dashboard/), with every asset
 // built in, that shows the running cell as DashboardFeed builds it, pushed to the browser by
-// server-sent events as it changes (docs/dashboard.md).
+// server-sent events as it changes (docs/dashboard.md), and each order's report, plan and
+// animation (`/orders/ID/report.html`, `plan.json`, `animation.gltf`).
 //
 // Only an operator with the token `cellctl up` prints (and writes to the state folder, 0600)
 // sees it: `/?token=T` sets a cookie (HttpOnly, SameSite=Strict) and every other request
@@ -14,6 +15,7 @@
 // connections delays the page by a few seconds, and no page can slow the feed or the cell.
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -28,6 +30,7 @@ class Dashboard {
   static constexpr int kOtherThreads = 24;
   static constexpr std::chrono::seconds kWriteTimeout{5};
   static constexpr std::chrono::seconds kReadTimeout{2};
+  static constexpr std::uintmax_t kMaxResultBytes = 256u << 20;  // an order's report, plan or animation
 
   // Listens at once; throws with the reason when it cannot (the port is taken).
   Dashboard(const DashboardAddress& address, const CellConfig& cell, const CellObserver& observer);

@@ -1,7 +1,8 @@
 // The cell's dashboard in Debian's headless chromium, as an operator would use it: starts
 // `cellctl up --dashboard` on a domain of its own, opens the address it printed, and checks
 // what a person would see: every resource of the cell; an order (submitted with cellctl)
-// advancing to DONE; a killed buffer turning gone, then back; no console error; no request
+// advancing to DONE, its report opening from the page's link; a killed buffer turning gone,
+// then back; no console error; no request
 // to anything but the dashboard. Prints the page's update latency (a DDS event heard by
 // cellctl up to the page's state drawn, p50 and p99) and can keep a screenshot of the page at
 // work. DASHBOARD_ORDERS=N submits N orders more (the latency of a busy cell).
@@ -114,6 +115,27 @@ function percentile(values, p) {
       await shows("dash-" + i, "DONE").catch(() => problems.push("order dash-" + i + " never showed DONE"));
     }
     submits.forEach((s) => s.kill("SIGTERM"));
+    // Its results, from the page's links: the report opens (sandboxed) with no error, the plan
+    // and the animation come as files.
+    const links = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-1")
+      .flatMap((tr) => [...tr.querySelectorAll("a")].map((a) => a.href)));
+    if (links.length !== 3) problems.push("dash-1 links to " + links.length + " results, not 3");
+    for (const link of links.filter((l) => !l.endsWith(".html"))) {
+      const status = await page.evaluate(async (l) => (await fetch(l)).status, link);
+      if (status !== 200) problems.push(link + ": HTTP " + status);
+    }
+    const report = await browser.newPage();
+    report.on("console", (m) => { if (m.type() === "error") problems.push("report: console error: " + m.text()); });
+    report.on("pageerror", (e) => problems.push("report: page error: " + e.message));
+    const opened = await report.goto(links.find((l) => l.endsWith("report.html")) || origin + "/none", { waitUntil: "load" });
+    if (!opened || opened.status() !== 200) problems.push("the report did not open: HTTP " + (opened && opened.status()));
+    await report.waitForFunction(() => document.body.dataset.viewer, { timeout: 45000 })
+      .then(async () => {
+        const viewer = await report.evaluate(() => document.body.dataset.viewer);
+        if (viewer !== "ready") problems.push("the report's 3D view did not start: " + viewer);
+      })
+      .catch(() => problems.push("the report's 3D view never said whether it started"));
+    await report.close();
     const bars = await page.evaluate(() => window.dashboard.bars.filter((b) => b.order === "dash-1").length);
     if (bars < 5) problems.push("the Gantt chart holds " + bars + " bars of dash-1's work");
 

@@ -118,6 +118,21 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
     CHECK(state["domain"] == 175);
     CHECK(state["attention"].empty());
 
+    // An order's results: only the three files, of an order the cell has.
+    const httplib::Headers bearer{{"Authorization", "Bearer " + token}};
+    r = client.Get("/orders/nope/plan.json", bearer);
+    REQUIRE(r);
+    CHECK(r->status == 404);
+    CHECK(r->body.find("no such order") != std::string::npos);
+    r = client.Get("/orders/nope/plan.json");
+    REQUIRE(r);
+    CHECK(r->status == 401);
+    for (const char* path : {"/orders/../../etc/passwd", "/orders/x/cell.db", "/orders/x/..%2F..%2Fcell.db"}) {
+      r = client.Get(path, bearer);
+      REQUIRE(r);
+      CHECK(r->status == 404);
+    }
+
     r = client.Post("/state", {{"Authorization", "Bearer " + token}}, std::string(100 * 1024, 'x'), "text/plain");
     REQUIRE(r);
     CHECK(r->status == 413);  // past 64 kB: refused, not read

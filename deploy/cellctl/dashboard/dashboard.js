@@ -58,8 +58,18 @@
       const bar = el("progress");
       bar.max = 1;
       bar.value = o.state === "DONE" ? 1 : o.progress || 0;
+      const results = el("span");
+      if (o.state === "DONE" || o.state === "FAILED") {
+        for (const file of ["report.html", "plan.json", "animation.gltf"]) {
+          const a = el("a", file.split(".")[0]);
+          a.href = "/orders/" + encodeURIComponent(o.order) + "/" + file;
+          a.target = "_blank";
+          a.rel = "noopener";
+          results.append(a, " ");
+        }
+      }
       return [o.order + (o.quote ? " (quote)" : ""), el("span", o.state, "state-" + o.state), bar, o.place ?? "",
-              o.message || "", o.reason || ""];
+              o.message || "", o.reason || "", results];
     }));
   }
   function renderInventory(inventory) {
