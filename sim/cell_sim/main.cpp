@@ -38,7 +38,13 @@ int main(int argc, char** argv) {
   const std::atomic<bool>& running = services::run_until_signalled();
   try {
     auto participant = dds::make_participant("cell-sim", settings);
-    fb::Resource resource("cell-sim", 1024);
+    // Before the resource: its reader's listener may answer through it until the resource is gone.
+    dds::Outbox<cell::SimReply, cell::SimReplyPubSubType> refusals(participant, "cell/sim/replies", dds::TopicKind::events);
+    // Every twin in virtual assembly spawns its product's parts at once: 40 twins of the
+    // Cranfield product and the Lego tower filled 1024 events (a clean-clone CI rehearsal's
+    // scale test, beside other load). Four times that; a request past it is answered "busy"
+    // (below). Not more: a queued move may hold 2048 waypoints.
+    fb::Resource resource("cell-sim", 4096);
     resource.add(std::make_unique<sim::WorldBlock>("world", factor, dds::apply_bounds(bounds)));
     auto& requests = resource.add(std::make_unique<dds::SubscribeBlock<cell::SimRequest, cell::SimRequestPubSubType>>(
         "requests", participant, "cell/sim/requests", dds::TopicKind::events,
@@ -67,6 +73,17 @@ int main(int argc, char** argv) {
           return fb::Data{{"resource_id", r.resource_id().to_string()}, {"order_id", r.order_id().to_string()}};
         }));
     resource.connect("hires", "IND", "world", "HIRED");
+    // A request that finds the queue full is answered so, not dropped: its requester would
+    // wait its whole timeout and blame a cell-sim that is not there.
+    requests.on_refused([&refusals](const cell::SimRequest& r, const std::string& why) {
+      cell::SimReply reply;
+      reply.request_id(r.request_id());
+      reply.requester(r.requester());
+      reply.ok(false);
+      reply.error("busy: cell-sim's event queue is " + why + "; ask again");
+      refusals.write(reply);
+    });
+    resource.on_idle([&refusals] { refusals.flush(); });
     // With the cell's state, the bodies of an order whose twin died wait for the next twin.
     std::unique_ptr<state::CellStore> store;
     if (!state_dir.empty()) store = std::make_unique<state::CellStore>(state_dir);
@@ -95,11 +112,19 @@ int main(int argc, char** argv) {
     orders.start();
     std::cout << "cell-sim ready on domain " << settings.domain_id << ", real-time factor " << factor << std::endl;
     auto last_check = std::chrono::steady_clock::now();
+    // Its own periodic events: a queue full of requests skips one (the next comes soon), and
+    // never ends the process (one did so, and the whole cell restarted).
+    const auto post_own = [&resource](const char* block, const char* input) {
+      try {
+        resource.post(block, input);
+      } catch (const fb::EventQueueOverflow&) {
+      }
+    };
     while (running) {
-      if (!resource.wait_and_run_one(std::chrono::milliseconds(1))) resource.post("world", "TICK");
+      if (!resource.wait_and_run_one(std::chrono::milliseconds(1))) post_own("world", "TICK");
       if (store && std::chrono::steady_clock::now() - last_check > std::chrono::seconds(1)) {
         last_check = std::chrono::steady_clock::now();
-        resource.post("order_watch", "CHECK");
+        post_own("order_watch", "CHECK");
       }
     }
   } catch (const std::exception& e) {

@@ -3,7 +3,9 @@
 // what the test says.
 
 #include <functional>
+#include <memory>
 #include <optional>
+#include <set>
 
 #include <catch2/catch.hpp>
 
@@ -76,13 +78,14 @@ struct Outcome {
 // never answered; kAcceptOnly: accepted, and never more); `ticks`: TICKs for the orchestrator
 // when nothing else is under way (its resends); `ahead`: the station's queue before this order; `turns_ours`: the station
 // that is reserved for the order once it said it waits (another than station-1: the booking
-// an earlier twin of the order left there).
+// an earlier twin of the order left there); `busy(request)`: cell-sim answers it "busy".
 const std::string kNoAnswer = "(no answer)";
 const std::string kAcceptOnly = "(accepted only)";
 struct Cell {
   std::function<bool(const Data&, long)> collide = [](const Data&, long) { return false; };
   std::function<std::string(const Data&)> refuse = [](const Data&) { return std::string(); };
   std::function<std::string(const Data&)> refuse_call = [](const Data&) { return std::string(); };  // a CFP
+  std::function<bool(const Data&)> busy = [](const Data&) { return false; };  // cell-sim's queue full
   long ahead = 0;
   std::string turns_ours = "station-1";
   int ticks = 0;
@@ -158,6 +161,14 @@ Outcome run(Twin& t, const Cell& cell) {
       out.order.push_back("SIM " + kind);
       if (kind == "spawn") out.spawned.push_back(get<std::string>(e.data, "body_id"));
       if (kind == "move") out.moves.push_back(e.data);
+      if (cell.busy(e.data)) {
+        more = t.send("orchestrator", "SIM_REPLY",
+                      {{"request_id", e.data.at("request_id")}, {"ok", false},
+                       {"error", std::string("busy: cell-sim's event queue is full (4096 events); ask again")},
+                       {"collided", false}});
+        pending.insert(pending.end(), more.begin(), more.end());
+        continue;
+      }
       const bool collided = kind == "move" && cell.collide(e.data, std::count(out.order.begin(), out.order.end(), "SIM set_static"));
       more = t.send("orchestrator", "SIM_REPLY",
                     {{"request_id", e.data.at("request_id")}, {"ok", true}, {"error", std::string()},
@@ -412,6 +423,26 @@ TEST_CASE("orchestrator: a part that fits nowhere in cell-sim fails the order, w
   CHECK(out.error.find("no collision-free path in cell-sim for hanging") != std::string::npos);
   CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") == out.order.end());  // never booked a station
   CHECK(t.orchestrator->state() == twin::Phase::ended);
+}
+
+TEST_CASE("orchestrator: a request cell-sim answers busy goes again at the next tick, and the order goes on",
+          "[twin][orchestration]") {
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
+  Twin t(lego.product, lego.plan);
+  Cell cell;
+  cell.ticks = 50;
+  auto answered_busy = std::make_shared<std::set<std::string>>();
+  cell.busy = [answered_busy](const Data& request) {  // the first two requests, once each
+    const std::string id = get<std::string>(request, "request_id");
+    if (answered_busy->size() >= 2 || answered_busy->count(id)) return false;
+    answered_busy->insert(id);
+    return true;
+  };
+  const Outcome out = run(t, cell);
+  INFO(out.error);
+  CHECK(out.finished);
+  CHECK(out.complete);
+  CHECK(answered_busy->size() == 2);
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {

@@ -91,6 +91,10 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     transition(in, "SIM_REPLY", in, [this](const Data& d) {
       if (!action_running_ || get<std::string>(d, "request_id") != awaited_id_) return;
       if (state() == Phase::cleanup) return action_done();
+      if (!get<bool>(d, "ok") && get<std::string>(d, "error").rfind("busy:", 0) == 0) {
+        sim_busy_ = true;
+        return;
+      }
       if (!get<bool>(d, "ok") && actions_.front().may_fail) return action_done();
       if (!get<bool>(d, "ok")) return fail("cell-sim refused: " + get<std::string>(d, "error"));
       if (fb::get_or<bool>(d, "collided", false) && actions_.front().retry_on_collision) {
@@ -165,7 +169,11 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       action_done();
     }
   });
-  transition(Phase::physical, "TICK", Phase::physical, [this](const Data&) { resend_unheard(); });
+  transition(Phase::physical, "TICK", Phase::physical, [this](const Data&) {
+    resend_unheard();
+    ask_sim_again();
+  });
+  transition(Phase::virtual_assembly, "TICK", Phase::virtual_assembly, [this](const Data&) { ask_sim_again(); });
   transition(Phase::physical, "PHYSICAL_DONE", Phase::cleanup, [this](const Data&) { plan_cleanup(); });
 
   // A failure anywhere cancels undelivered fetches (fail) and cleans up; the order's twin
@@ -643,6 +651,12 @@ void OrderOrchestrator::plan_physical() {
   delivered_.insert(script.delivered.begin(), script.delivered.end());
   spawned_.insert(script.spawned.begin(), script.spawned.end());
   next_action();
+}
+
+void OrderOrchestrator::ask_sim_again() {
+  if (!sim_busy_) return;
+  sim_busy_ = false;
+  if (action_running_ && !actions_.empty() && actions_.front().kind == Action::sim) emit("SIM", actions_.front().data);
 }
 
 void OrderOrchestrator::plan_cleanup() {

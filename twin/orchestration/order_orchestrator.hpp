@@ -174,6 +174,8 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   void back_to_sequence_planning();
   void send_command(const fb::Data& command);
   void resend_unheard();
+  // cell-sim answered "busy" (its queue was full): the request goes again at the next TICK.
+  void ask_sim_again();
   void fail(const std::string& reason);
   void finish();
   void status(const std::string& state, const std::string& message, double progress);
@@ -198,6 +200,7 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   Script actions_;
   bool action_running_ = false;
   std::string awaited_id_;
+  bool sim_busy_ = false;
   std::size_t command_count_ = 0;
   std::size_t step_ = 0, candidate_ = 0;
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
