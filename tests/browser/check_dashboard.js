@@ -14,18 +14,8 @@ const os = require("os");
 const path = require("path");
 const { spawn, spawnSync } = require("child_process");
 
-const chromium = process.env.CHROMIUM || "/usr/bin/chromium";
-let puppeteer;
-try {
-  puppeteer = require("puppeteer-core");
-} catch (e) {
-  console.log("skipped: npm ci --prefix tests/browser has not run (" + e.message + ")");
-  process.exit(77);
-}
-if (!fs.existsSync(chromium)) {
-  console.log("skipped: no chromium at " + chromium);
-  process.exit(77);
-}
+const { puppeteerOrSkip, launch } = require("./chromium");
+const puppeteer = puppeteerOrSkip();
 const [cellctl, cellFile, domain, product, screenshot] = process.argv.slice(2);
 const scratch = fs.mkdtempSync(path.join(os.tmpdir(), "dashboard-"));
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -73,11 +63,7 @@ function percentile(values, p) {
     await appears(upLog, /cell up on domain/, 90);
     const origin = new URL(url).origin;
 
-    browser = await puppeteer.launch({
-      executablePath: chromium,
-      headless: true,
-      args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-sandbox"],
-    });
+    browser = await launch(puppeteer);
     const page = await browser.newPage();
     await page.setViewport({ width: 1400, height: 1100 });
     page.on("console", (m) => { if (m.type() === "error") problems.push("console error: " + m.text()); });

@@ -3,20 +3,15 @@
 // is not blank, and a click on a finding that changes it. Exit 0: all good; 1: a check failed;
 // 77: no chromium or puppeteer-core here (ctest shows the test as skipped).
 "use strict";
-const fs = require("fs");
 const path = require("path");
 
-const chromium = process.env.CHROMIUM || "/usr/bin/chromium";
-let puppeteer, PNG;
+const { puppeteerOrSkip, launch } = require("./chromium");
+const puppeteer = puppeteerOrSkip();
+let PNG;
 try {
-  puppeteer = require("puppeteer-core");
   PNG = require("pngjs").PNG;
 } catch (e) {
   console.log("skipped: npm ci --prefix tests/browser has not run (" + e.message + ")");
-  process.exit(77);
-}
-if (!fs.existsSync(chromium)) {
-  console.log("skipped: no chromium at " + chromium);
   process.exit(77);
 }
 
@@ -94,11 +89,7 @@ async function check(browser, file) {
 }
 
 (async () => {
-  const browser = await puppeteer.launch({
-    executablePath: chromium,
-    headless: true,
-    args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-sandbox"],
-  });
+  const browser = await launch(puppeteer);
   let failed = 0;
   try {
     for (const file of process.argv.slice(2)) {
