@@ -92,9 +92,13 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       if (!action_running_ || get<std::string>(d, "request_id") != awaited_id_) return;
       if (state() == Phase::cleanup) return action_done();
       if (!get<bool>(d, "ok") && get<std::string>(d, "error").rfind("busy:", 0) == 0) {
+        // Asked again at the next tick, but not for ever: a cell-sim busy this long (or a
+        // sender that only answers so) fails the order with the reason.
+        if (++busy_answers_ > kMaxBusyAnswers) return fail("cell-sim refused: " + get<std::string>(d, "error"));
         sim_busy_ = true;
         return;
       }
+      busy_answers_ = 0;
       if (!get<bool>(d, "ok") && actions_.front().may_fail) return action_done();
       if (!get<bool>(d, "ok")) return fail("cell-sim refused: " + get<std::string>(d, "error"));
       if (fb::get_or<bool>(d, "collided", false) && actions_.front().retry_on_collision) {

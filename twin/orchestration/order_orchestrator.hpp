@@ -201,6 +201,8 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   bool action_running_ = false;
   std::string awaited_id_;
   bool sim_busy_ = false;
+  int busy_answers_ = 0;  // in a row
+  static constexpr int kMaxBusyAnswers = 300;  // at a tick each: 30 s
   std::size_t command_count_ = 0;
   std::size_t step_ = 0, candidate_ = 0;
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
