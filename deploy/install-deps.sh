@@ -23,6 +23,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools libssl-dev openssl
   libjs-three    # the designer's report carries three.js (built into cellctl and the twin)
   libcpp-httplib-dev  # cellctl up's dashboard: its HTTP server
+  libminizip-dev      # the dashboard's uploads: a product as one zip
 )
 if $tests; then
   packages+=(

@@ -10,9 +10,11 @@
 #include <thread>
 
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 
 #include "deploy/cellctl/dashboard_assets.hpp"
 #include "deploy/cellctl/dashboard_feed.hpp"
+#include "deploy/cellctl/order_intake.hpp"
 #include "services/state/cell_store.hpp"
 #include "twin/report/viewer/viewer_assets.hpp"
 
@@ -69,6 +71,7 @@ struct Dashboard::Impl {
   int port = 0;
   httplib::Server server;
   std::atomic<int> followers{0};
+  std::atomic<int> uploads{0};
   std::atomic<bool> stopping{false};
   std::thread thread;
 
@@ -135,6 +138,63 @@ struct Dashboard::Impl {
     }
   }
 
+  // Before a request's body is read: only an upload of the operator's has one larger than a
+  // form's, and it needs the token first.
+  httplib::Server::HandlerResponse before_body(const httplib::Request& req, httplib::Response& res) const {
+    using Handled = httplib::Server::HandlerResponse;
+    const bool upload = req.method == "POST" && req.path == "/orders";
+    const auto length = req.get_header_value<std::uint64_t>("Content-Length");
+    if (!upload && (length > kMaxFormBytes || req.has_header("Transfer-Encoding"))) {
+      res.status = 413;
+      res.set_header("Connection", "close");
+      res.set_content("this request's body is larger than the dashboard takes\n", "text/plain");
+      return Handled::Handled;
+    }
+    if (req.method != "POST") return Handled::Unhandled;
+    if (!allowed(req, res)) return Handled::Handled;
+    // A page of another site may post here with the operator's cookie no more than read (the
+    // cookie is SameSite=Strict); a browser names the page's origin, and it must be this one.
+    const std::string origin = req.get_header_value("Origin");
+    if (!origin.empty() && origin != "http://" + req.get_header_value("Host")) {
+      res.status = 403;
+      res.set_content("an action on this cell comes from its own dashboard only\n", "text/plain");
+      return Handled::Handled;
+    }
+    return Handled::Unhandled;
+  }
+
+  // POST /orders[?order=ID], the body a product's zip: an order, as `cellctl submit` makes one.
+  void take_upload(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
+    if (++uploads > kMaxUploads) {
+      --uploads;
+      res.status = 503;
+      res.set_content(std::to_string(kMaxUploads) + " uploads are under way; send this one when they are done\n", "text/plain");
+      return;
+    }
+    std::string zip;
+    const auto limit = max_upload_bytes();
+    UploadAnswer answer{413, "", "the upload is larger than the desk takes (desk: max_order_mb)"};
+    if (req.get_header_value<std::uint64_t>("Content-Length") <= limit) {
+      bool over = false;
+      const bool whole = content([&](const char* data, std::size_t n) {
+        over = zip.size() + n > limit;
+        if (!over) zip.append(data, n);
+        return !over;
+      });
+      if (!whole && !over) {
+        answer = {400, "", "the upload did not arrive whole"};
+      } else if (whole) {
+        state::CellStore store(cell.state_folder());
+        answer = cellctl::take_upload(cell, store, zip, req.get_param_value("order"), "dashboard");
+      }
+    }
+    --uploads;
+    res.status = answer.status;
+    res.set_content(nlohmann::json{{"order", answer.order}, {"message", answer.message}}.dump(), "application/json");
+  }
+
+  std::size_t max_upload_bytes() const { return static_cast<std::size_t>(cell.desk.max_order_mb * 1e6) + (1u << 20); }
+
   void follow(httplib::Response& res) {
     if (++followers > kMaxFollowers) {
       --followers;
@@ -173,7 +233,8 @@ Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, co
   d.host = address.host;
   auto& s = d.server;
   s.new_task_queue = [] { return new httplib::ThreadPool(kMaxFollowers + kOtherThreads); };
-  s.set_payload_max_length(64 * 1024);
+  s.set_payload_max_length(d.max_upload_bytes());  // other requests: kMaxFormBytes (before_body)
+  s.set_pre_routing_handler([&d](const httplib::Request& req, httplib::Response& res) { return d.before_body(req, res); });
   s.set_read_timeout(kReadTimeout.count(), 0);
   s.set_write_timeout(kWriteTimeout.count(), 0);
   s.set_keep_alive_max_count(20);
@@ -210,6 +271,9 @@ Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, co
         [&d](const httplib::Request& req, httplib::Response& res) {
           if (d.allowed(req, res)) d.serve_result(req.matches[1], req.matches[2], res);
         });
+  s.Post("/orders", [&d](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
+    d.take_upload(req, res, content);
+  });
   if (address.port == 0 ? (d.port = s.bind_to_any_port(address.host)) <= 0
                         : !s.bind_to_port(address.host, address.port)) {
     throw std::runtime_error("the dashboard cannot listen on " + address.host + ":" + std::to_string(address.port) +

@@ -5,9 +5,7 @@
 #include <optional>
 
 #include "deploy/cellctl/order_desk.hpp"
-#include "twin/description/automationml/automationml_description.hpp"
-#include "twin/description/product_description.hpp"
-#include "twin/model/source_ref.hpp"
+#include "deploy/cellctl/order_intake.hpp"
 
 namespace cellctl {
 
@@ -26,20 +24,6 @@ std::string text_of(cell::DeskState s) {
     case cell::DESK_FAILED: return "failed";
   }
   return "?";
-}
-
-// "a.aml:12: ..." instead of "/var/.../desk/oem-a/7/product/a.aml:12: ...": the client knows
-// its files by their names.
-std::string relative_to(std::string message, const fs::path& folder) {
-  const std::string prefix = folder.string() + "/";
-  for (auto at = message.find(prefix); at != std::string::npos; at = message.find(prefix)) message.erase(at, prefix.size());
-  return message;
-}
-
-bool good_submission(const std::string& s) {
-  return !s.empty() && s.size() <= 64 &&
-         s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") == std::string::npos &&
-         s.front() != '.';
 }
 
 }  // namespace
@@ -63,7 +47,7 @@ struct RemoteDesk::Client {
     if (upload_errors.count(submission)) return;
     auto it = uploads.find(submission);
     if (it == uploads.end()) {
-      if (!good_submission(submission)) return;  // answered when its order comes
+      if (!good_order_id(submission)) return;  // answered when its order comes
       while (upload_order.size() >= kUploadsPerClient) {  // an upload never finished: the oldest goes
         uploads.erase(upload_order.front());
         upload_order.pop_front();
@@ -162,7 +146,7 @@ void RemoteDesk::take_order(Client& client, const cell::OrderRequest& request) {
     return refuse(client, request, "the desk takes " + std::to_string(cell_.desk.orders_per_minute) +
                                        " orders a minute from a client; try again in a minute", 1);
   }
-  if (!good_submission(submission)) return refuse(client, request, "a submission id is 1 to 64 of A-Z, a-z, 0-9, ., _ and -", 2);
+  if (!good_order_id(submission)) return refuse(client, request, "a submission id is 1 to 64 of A-Z, a-z, 0-9, ., _ and -", 2);
   std::optional<FileAssembly> upload;
   {
     std::lock_guard<std::mutex> lock(client.mutex);
@@ -224,11 +208,9 @@ void RemoteDesk::store_order(Client& client, const cell::OrderRequest& request, 
       out << *upload.complete(f.name().to_string());
       if (!out.flush()) throw std::runtime_error("cannot write " + file.string());
     }
-    try {
-      twin::build_product(twin::AutomationMLDescription(folder / "product" / product));
-    } catch (const twin::DescriptionError& e) {
+    if (const std::string error = description_error(folder / "product" / product, folder / "product"); !error.empty()) {
       fs::remove_all(folder, ignored);
-      return refuse(client, request, relative_to(e.what(), folder / "product"), 2);
+      return refuse(client, request, error, 2);
     }
     fs::create_directories(folder / "out");
     state::OrderRecord record{order, "", "", (folder / "product" / product).string(), (folder / "out").string(), sequence, "linear"};

@@ -1,12 +1,13 @@
 // The cell's dashboard in Debian's headless chromium, as an operator would use it: starts
 // `cellctl up --dashboard` on a domain of its own, opens the address it printed, and checks
-// what a person would see: every resource of the cell; an order (submitted with cellctl)
+// what a person would see: every resource of the cell; a file that is not a product's zip
+// refused with the reason; an order submitted through the page's form (the product's zip)
 // advancing to DONE, its report opening from the page's link; a killed buffer turning gone,
 // then back; no console error; no request
 // to anything but the dashboard. Prints the page's update latency (a DDS event heard by
 // cellctl up to the page's state drawn, p50 and p99) and can keep a screenshot of the page at
 // work. DASHBOARD_ORDERS=N submits N orders more (the latency of a busy cell).
-//   node check_dashboard.js CELLCTL CELL.yaml DOMAIN PRODUCT.aml [SCREENSHOT.png]
+//   node check_dashboard.js CELLCTL CELL.yaml DOMAIN PRODUCT.aml PRODUCT.zip [SCREENSHOT.png]
 // Exit 0: all good; 1: a check failed; 77: no chromium or puppeteer-core here (skipped).
 "use strict";
 const fs = require("fs");
@@ -16,7 +17,7 @@ const { spawn, spawnSync } = require("child_process");
 
 const { puppeteerOrSkip, launch } = require("./chromium");
 const puppeteer = puppeteerOrSkip();
-const [cellctl, cellFile, domain, product, screenshot] = process.argv.slice(2);
+const [cellctl, cellFile, domain, product, productZip, screenshot] = process.argv.slice(2);
 const scratch = fs.mkdtempSync(path.join(os.tmpdir(), "dashboard-"));
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
@@ -66,7 +67,11 @@ function percentile(values, p) {
     browser = await launch(puppeteer);
     const page = await browser.newPage();
     await page.setViewport({ width: 1400, height: 1100 });
-    page.on("console", (m) => { if (m.type() === "error") problems.push("console error: " + m.text()); });
+    // The browser logs an answer 400 as an error: the one to the upload refused on purpose is not.
+    let refusing = false;
+    page.on("console", (m) => {
+      if (m.type() === "error" && !(refusing && /status of 400/.test(m.text()))) problems.push("console error: " + m.text());
+    });
     page.on("pageerror", (e) => problems.push("page error: " + e.message));
     page.on("request", (r) => {
       if (!r.url().startsWith(origin + "/") && !r.url().startsWith("data:")) problems.push("requested " + r.url());
@@ -83,11 +88,29 @@ function percentile(values, p) {
       return ids.every((id) => shown.includes(id));
     }, { timeout: 20000 }, ids).catch(() => problems.push("the page does not show every resource: " + ids.join(", ")));
 
-    // An order to its end (DASHBOARD_ORDERS more besides, for a measurement of the latency
-    // while the cell is busy).
+    // The page's form: a file that is not a zip is refused, with the reason shown; the
+    // product's zip becomes order dash-1.
+    const upload = async (file, id) => {
+      await page.evaluate(() => { document.getElementById("submit-answer").textContent = ""; });
+      await (await page.$("#submit-file")).uploadFile(file);
+      await page.$eval("#submit-id", (input, id) => { input.value = id; }, id);
+      await page.click("#submit-button");
+      await page.waitForFunction(() => /order|zip|archive|refused|larger|cell/.test(document.getElementById("submit-answer").textContent)
+        && !document.getElementById("submit-button").disabled, { timeout: 30000 });
+      return page.$eval("#submit-answer", (o) => ({ text: o.textContent, cls: o.className }));
+    };
+    refusing = true;
+    const refused = await upload(product, "dash-0");
+    refusing = false;
+    if (refused.cls !== "answer-refused" || !refused.text.includes("not a zip archive")) {
+      problems.push("an .aml sent as the product's zip was not refused with the reason: " + JSON.stringify(refused));
+    }
+    const taken = await upload(productZip, "dash-1");
+    if (taken.cls !== "answer-ok" || !taken.text.includes("dash-1")) problems.push("the product's zip was not taken: " + JSON.stringify(taken));
+    // DASHBOARD_ORDERS more, by cellctl, for a measurement of the latency while the cell is busy.
     const extra = Number(process.env.DASHBOARD_ORDERS || 0);
     const submits = [];
-    for (let i = 1; i <= 1 + extra; ++i) {
+    for (let i = 2; i <= 1 + extra; ++i) {
       submits.push(spawn(cellctl, ["submit", product, "--domain", domain, "--order", "dash-" + i, "--out",
                                    path.join(scratch, "dash-" + i), "--detach"], { stdio: "ignore" }));
     }

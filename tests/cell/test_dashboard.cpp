@@ -1,6 +1,7 @@
 // cellctl up's dashboard over HTTP, as a stranger and as a crowd would use it: nothing
 // without the token, the token out of the address once used, the page's policy, a bound on
-// the pages that follow the cell, and stalled connections that do not stop it answering.
+// the pages that follow the cell, stalled connections that do not stop it answering, and
+// the operator's uploads that become orders (bad and hostile ones refused, nothing kept).
 // (What a person sees in a browser: tests/browser/check_dashboard.js.)
 
 #include <arpa/inet.h>
@@ -9,8 +10,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -161,6 +164,97 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
     CHECK(std::chrono::steady_clock::now() - asked < 12s);
   }
 
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes an order of the cell's; a stranger's, "
+          "another site's, a hostile or a bad one is refused with the reason, and nothing is kept",
+          "[process][cell][dashboard]") {
+  using namespace std::chrono_literals;
+  namespace fs = std::filesystem;
+  const auto dir = test::scratch("dashboard-orders");
+  const std::string domain = "173";
+  test::clean_stale_dds_segments();
+  test::ChildProcess up({CELLCTL_EXE, "up", DEFAULT_CELL, "--domain", domain, "--state-dir", (dir / "state").string(),
+                         "--dashboard", "127.0.0.1:0"},
+                        (dir / "up.log").string());
+  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 90s));
+  std::smatch m;
+  const std::string log = test::read_text(dir / "up.log");
+  REQUIRE(std::regex_search(log, m, std::regex("dashboard: http://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
+  const int port = std::stoi(m[1]);
+  const httplib::Headers bearer{{"Authorization", "Bearer " + std::string(m[2])}};
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(30, 0);
+  const std::string zip = test::read_text(LEGO_ZIP);
+  REQUIRE(zip.size() > 1000);
+  const auto uploads = dir / "state" / "uploads";
+  const auto message_of = [](const httplib::Result& r) { return nlohmann::json::parse(r->body).value("message", ""); };
+
+  // A stranger's upload is answered before its body is read: a declared gigabyte, never sent.
+  RawConnection stranger(port, "POST /orders HTTP/1.1\r\nHost: x\r\nContent-Type: application/zip\r\nContent-Length: 1000000000\r\n\r\n");
+  CHECK(stranger.status() == 401);
+  // Past the desk's limit (64 MB by default), refused before it is read.
+  RawConnection too_large(port, "POST /orders HTTP/1.1\r\nHost: x\r\nAuthorization: " + bearer.begin()->second +
+                                    "\r\nContent-Length: 1000000000\r\n\r\n");
+  CHECK(too_large.status() == 413);
+  // Another site's page, with the operator's credentials: refused.
+  auto foreign = bearer;
+  foreign.emplace("Origin", "http://evil.example");
+  auto r = client.Post("/orders?order=o-foreign", foreign, zip, "application/zip");
+  REQUIRE(r);
+  CHECK(r->status == 403);
+
+  // Bad and hostile archives: refused with the reason, nothing kept.
+  r = client.Post("/orders?order=o-bad", bearer, "not a zip", "application/zip");
+  REQUIRE(r);
+  CHECK(r->status == 400);
+  CHECK(message_of(r).find("not a zip archive") != std::string::npos);
+  // The description's entry renamed, in both of the zip's directories, to a path as long
+  // that leaves the folder.
+  std::string tampered = zip;
+  for (auto at = tampered.find("lego-tower/lego-tower.aml"); at != std::string::npos;
+       at = tampered.find("lego-tower/lego-tower.aml")) {
+    tampered.replace(at, 25, "../../../../../etc/xx.aml");
+  }
+  r = client.Post("/orders?order=o-escape", bearer, tampered, "application/zip");
+  REQUIRE(r);
+  CHECK(r->status == 400);
+  CHECK(message_of(r).find("leaves the product's folder") != std::string::npos);
+  r = client.Post("/orders?order=../../x", bearer, zip, "application/zip");
+  REQUIRE(r);
+  CHECK(r->status == 400);
+  CHECK(message_of(r).find("id") != std::string::npos);
+  CHECK((!fs::exists(uploads) || fs::is_empty(uploads)));
+
+  // The product's zip: an order, journalled as the dashboard's, then the same id refused.
+  r = client.Post("/orders?order=o-1", bearer, zip, "application/zip");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  CHECK(nlohmann::json::parse(r->body)["order"] == "o-1");
+  CHECK(fs::exists(uploads / "o-1" / "product" / "lego-tower" / "lego-tower.aml"));
+  r = client.Post("/orders?order=o-1", bearer, zip, "application/zip");
+  REQUIRE(r);
+  CHECK(r->status == 409);
+  r = client.Post("/orders", bearer, zip, "application/zip");  // no id: one is made
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  const std::string made = nlohmann::json::parse(r->body)["order"];
+  CHECK(made.rfind("upload-", 0) == 0);
+
+  // Both show on the page's state.
+  bool shown = false;
+  for (auto until = std::chrono::steady_clock::now() + 20s; !shown && std::chrono::steady_clock::now() < until;
+       std::this_thread::sleep_for(200ms)) {
+    r = client.Get("/state", bearer);
+    REQUIRE(r);
+    const auto state = nlohmann::json::parse(r->body);
+    int found = 0;
+    for (const auto& o : state["orders"]) found += o["order"] == "o-1" || o["order"] == made;
+    shown = found == 2;
+  }
+  CHECK(shown);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }

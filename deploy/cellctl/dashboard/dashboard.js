@@ -234,7 +234,39 @@
     });
   }
 
+  // An order from a product's zip, through the cell's desk (POST /orders): the answer, or the
+  // refusal's reason, under the form.
+  function takeOrders() {
+    const form = document.getElementById("submit-form");
+    const answer = document.getElementById("submit-answer");
+    form.addEventListener("submit", async (e) => {
+      e.preventDefault();
+      const file = document.getElementById("submit-file").files[0];
+      const id = document.getElementById("submit-id").value.trim();
+      const button = document.getElementById("submit-button");
+      button.disabled = true;
+      answer.className = "";
+      answer.textContent = "sending " + file.name + "...";
+      try {
+        const response = await fetch("/orders" + (id ? "?order=" + encodeURIComponent(id) : ""),
+                                     { method: "POST", body: file, headers: { "Content-Type": "application/zip" } });
+        const text = await response.text();
+        let message = text;
+        try { message = JSON.parse(text).message; } catch (ignored) { /* a plain-text answer */ }
+        answer.textContent = message;
+        answer.className = response.ok ? "answer-ok" : "answer-refused";
+        if (response.ok) form.reset();
+      } catch (error) {
+        answer.textContent = "the cell did not answer: " + error.message;
+        answer.className = "answer-refused";
+      } finally {
+        button.disabled = false;
+      }
+    });
+  }
+
   startScene();
+  takeOrders();
   follow();
   setInterval(() => {
     if (!page.state) return;
