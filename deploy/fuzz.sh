@@ -15,7 +15,7 @@ if [ -z "$build" ]; then
   build=build/fuzz
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
     -DCELL_FUZZ=ON -DCELL_BUILD_TESTS=OFF -DCELL_BUILD_BENCHMARKS=OFF
-  cmake --build "$build" -j "$(nproc)" --target fuzz_automationml fuzz_mesh fuzz_samples
+  cmake --build "$build" -j "$(nproc)" --target fuzz_automationml fuzz_mesh fuzz_samples fuzz_dashboard_requests
 fi
 out=build/fuzz
 mkdir -p "$out/artifacts"
@@ -41,3 +41,4 @@ run fuzz_automationml deploy/products/lego-tower deploy/products/cranfield
 # ours to fix, docs/hostile-input.md): leaks are not checked for this target, crashes are.
 LEAKS=0 run fuzz_mesh deploy/products/lego-tower/meshes deploy/products/cranfield/meshes -detect_leaks=0
 run fuzz_samples
+run fuzz_dashboard_requests

@@ -1,58 +1,15 @@
 #include "deploy/cellctl/dashboard.hpp"
 
-#include <openssl/crypto.h>
-#include <openssl/rand.h>
-
 #include <atomic>
-#include <filesystem>
-#include <fstream>
-#include <iostream>
 #include <thread>
 
 #include <httplib.h>
-#include <nlohmann/json.hpp>
 
-#include "deploy/cellctl/dashboard_assets.hpp"
 #include "deploy/cellctl/dashboard_feed.hpp"
-#include "deploy/cellctl/order_intake.hpp"
-#include "services/state/cell_store.hpp"
-#include "twin/report/viewer/viewer_assets.hpp"
+#include "deploy/cellctl/dashboard_routes.hpp"
 
 namespace cellctl {
 namespace {
-
-constexpr const char* kCookie = "cell_token";
-
-std::string new_token() {
-  unsigned char bytes[24];
-  if (RAND_bytes(bytes, sizeof bytes) != 1) throw std::runtime_error("no random bytes for the dashboard's token");
-  static const char* hex = "0123456789abcdef";
-  std::string token;
-  for (unsigned char b : bytes) {
-    token += hex[b >> 4];
-    token += hex[b & 15];
-  }
-  return token;
-}
-
-bool same(const std::string& a, const std::string& b) {
-  return a.size() == b.size() && CRYPTO_memcmp(a.data(), b.data(), a.size()) == 0;
-}
-
-// The token a request carries: `Authorization: Bearer T` or the cookie.
-std::string token_of(const httplib::Request& req) {
-  const std::string auth = req.get_header_value("Authorization");
-  if (auth.rfind("Bearer ", 0) == 0) return auth.substr(7);
-  const std::string cookies = req.get_header_value("Cookie");
-  const std::string key = std::string(kCookie) + "=";
-  for (std::size_t at = cookies.find(key); at != std::string::npos; at = cookies.find(key, at + 1)) {
-    if (at == 0 || cookies[at - 1] == ' ' || cookies[at - 1] == ';') {
-      const std::size_t end = cookies.find(';', at);
-      return cookies.substr(at + key.size(), end == std::string::npos ? std::string::npos : end - at - key.size());
-    }
-  }
-  return "";
-}
 
 // One server-sent event: `data:` lines may not hold a line break, and JSON text has none.
 std::string event(const char* name, const std::string& data) {
@@ -62,138 +19,16 @@ std::string event(const char* name, const std::string& data) {
 }  // namespace
 
 struct Dashboard::Impl {
-  Impl(const CellConfig& cell, const CellObserver& observer) : cell(cell), feed(cell, observer), token(new_token()) {}
+  Impl(const CellConfig& cell, const CellObserver& observer) : routes(cell, new_token()), feed(cell, observer) {}
 
-  const CellConfig& cell;
+  DashboardRoutes routes;
   DashboardFeed feed;
-  std::string token;
   std::string host;
   int port = 0;
   httplib::Server server;
   std::atomic<int> followers{0};
-  std::atomic<int> uploads{0};
   std::atomic<bool> stopping{false};
   std::thread thread;
-
-  bool allowed(const httplib::Request& req, httplib::Response& res) const {
-    if (same(token_of(req), token)) return true;
-    res.status = 401;
-    res.set_content("This cell's dashboard needs the operator token that cellctl up printed: open the address it gave, "
-                    "with ?token=...\n",
-                    "text/plain");
-    return false;
-  }
-
-  void serve_page(const httplib::Request& req, httplib::Response& res) const {
-    if (req.has_param("token")) {
-      if (!same(req.get_param_value("token"), token)) {
-        res.status = 401;
-        res.set_content("wrong token\n", "text/plain");
-        return;
-      }
-      // Out of the address bar and the history: the cookie carries it from now on.
-      res.set_header("Set-Cookie", std::string(kCookie) + "=" + token + "; Path=/; HttpOnly; SameSite=Strict");
-      res.set_redirect("/");
-      return;
-    }
-    if (!allowed(req, res)) return;
-    res.set_content(std::string(dashboard::page_html()), "text/html; charset=utf-8");
-  }
-
-  // An order's report, plan or animation, from the folder its twin wrote them to.
-  void serve_result(const std::string& order, const std::string& file, httplib::Response& res) const {
-    std::string out;
-    for (const auto& o : state::CellStore(cell.state_folder()).orders()) {
-      if (o.order == order) out = o.out;
-    }
-    const std::filesystem::path path = std::filesystem::path(out) / file;
-    std::error_code error;
-    const auto size = out.empty() ? 0 : std::filesystem::file_size(path, error);
-    if (out.empty() || error) {
-      res.status = 404;
-      res.set_content("order " + order + " has no " + file + (out.empty() ? " (no such order)" : " (yet)") + "\n",
-                      "text/plain");
-      return;
-    }
-    if (size > kMaxResultBytes) {
-      res.status = 413;
-      res.set_content(file + " of order " + order + " is larger than the dashboard serves: read it from " + path.string() + "\n",
-                      "text/plain");
-      return;
-    }
-    std::ifstream in(path, std::ios::binary);
-    std::string bytes(size, '\0');
-    in.read(bytes.data(), static_cast<std::streamsize>(size));
-    if (file == "report.html") {
-      // The report runs its own inline viewer, sandboxed: an origin of its own, no access to
-      // the dashboard's. Its policy replaces the page's (two would both apply).
-      res.headers.erase("Content-Security-Policy");
-      res.set_header("Content-Security-Policy",
-                     "sandbox allow-scripts; default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; "
-                     "img-src data: blob:; connect-src data: blob:");
-      res.set_content(std::move(bytes), "text/html; charset=utf-8");
-    } else {
-      res.set_header("Content-Disposition", "attachment; filename=\"" + order + "-" + file + "\"");
-      res.set_content(std::move(bytes), file == "plan.json" ? "application/json" : "model/gltf+json");
-    }
-  }
-
-  // Before a request's body is read: only an upload of the operator's has one larger than a
-  // form's, and it needs the token first.
-  httplib::Server::HandlerResponse before_body(const httplib::Request& req, httplib::Response& res) const {
-    using Handled = httplib::Server::HandlerResponse;
-    const bool upload = req.method == "POST" && req.path == "/orders";
-    const auto length = req.get_header_value<std::uint64_t>("Content-Length");
-    if (!upload && (length > kMaxFormBytes || req.has_header("Transfer-Encoding"))) {
-      res.status = 413;
-      res.set_header("Connection", "close");
-      res.set_content("this request's body is larger than the dashboard takes\n", "text/plain");
-      return Handled::Handled;
-    }
-    if (req.method != "POST") return Handled::Unhandled;
-    if (!allowed(req, res)) return Handled::Handled;
-    // A page of another site may post here with the operator's cookie no more than read (the
-    // cookie is SameSite=Strict); a browser names the page's origin, and it must be this one.
-    const std::string origin = req.get_header_value("Origin");
-    if (!origin.empty() && origin != "http://" + req.get_header_value("Host")) {
-      res.status = 403;
-      res.set_content("an action on this cell comes from its own dashboard only\n", "text/plain");
-      return Handled::Handled;
-    }
-    return Handled::Unhandled;
-  }
-
-  // POST /orders[?order=ID], the body a product's zip: an order, as `cellctl submit` makes one.
-  void take_upload(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
-    if (++uploads > kMaxUploads) {
-      --uploads;
-      res.status = 503;
-      res.set_content(std::to_string(kMaxUploads) + " uploads are under way; send this one when they are done\n", "text/plain");
-      return;
-    }
-    std::string zip;
-    const auto limit = max_upload_bytes();
-    UploadAnswer answer{413, "", "the upload is larger than the desk takes (desk: max_order_mb)"};
-    if (req.get_header_value<std::uint64_t>("Content-Length") <= limit) {
-      bool over = false;
-      const bool whole = content([&](const char* data, std::size_t n) {
-        over = zip.size() + n > limit;
-        if (!over) zip.append(data, n);
-        return !over;
-      });
-      if (!whole && !over) {
-        answer = {400, "", "the upload did not arrive whole"};
-      } else if (whole) {
-        state::CellStore store(cell.state_folder());
-        answer = cellctl::take_upload(cell, store, zip, req.get_param_value("order"), "dashboard");
-      }
-    }
-    --uploads;
-    res.status = answer.status;
-    res.set_content(nlohmann::json{{"order", answer.order}, {"message", answer.message}}.dump(), "application/json");
-  }
-
-  std::size_t max_upload_bytes() const { return static_cast<std::size_t>(cell.desk.max_order_mb * 1e6) + (1u << 20); }
 
   void follow(httplib::Response& res) {
     if (++followers > kMaxFollowers) {
@@ -233,46 +68,17 @@ Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, co
   d.host = address.host;
   auto& s = d.server;
   s.new_task_queue = [] { return new httplib::ThreadPool(kMaxFollowers + kOtherThreads); };
-  s.set_payload_max_length(d.max_upload_bytes());  // other requests: kMaxFormBytes (before_body)
-  s.set_pre_routing_handler([&d](const httplib::Request& req, httplib::Response& res) { return d.before_body(req, res); });
   s.set_read_timeout(kReadTimeout.count(), 0);
   s.set_write_timeout(kWriteTimeout.count(), 0);
   s.set_keep_alive_max_count(20);
-  s.set_default_headers({{"Content-Security-Policy",
-                          "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
-                          "img-src 'self' data:; frame-ancestors 'none'; base-uri 'none'; form-action 'self'"},
-                         {"X-Content-Type-Options", "nosniff"},
-                         {"Referrer-Policy", "no-referrer"}});
-  s.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
-    res.status = 500;
-    res.set_content("the dashboard could not answer this request\n", "text/plain");
-  });
-  s.Get("/", [&d](const httplib::Request& req, httplib::Response& res) { d.serve_page(req, res); });
-  // The page's own script and style: no cell data in them, served to anyone (the policy
-  // allows scripts from here only).
-  s.Get("/dashboard.js", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content(std::string(dashboard::script_js()), "text/javascript; charset=utf-8");
-  });
-  s.Get("/three.js", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content(std::string(twin::viewer::three_js()), "text/javascript; charset=utf-8");
-  });
-  s.Get("/dashboard.css", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content(std::string(dashboard::style_css()), "text/css; charset=utf-8");
-  });
+  d.routes.install(s);
   s.Get("/state", [&d](const httplib::Request& req, httplib::Response& res) {
-    if (!d.allowed(req, res)) return;
+    if (!d.routes.allowed(req, res)) return;
     res.set_header("Cache-Control", "no-store");
     res.set_content(d.feed.wait_newer(0, std::chrono::seconds(2)).json, "application/json");
   });
   s.Get("/events", [&d](const httplib::Request& req, httplib::Response& res) {
-    if (d.allowed(req, res)) d.follow(res);
-  });
-  s.Get(R"(/orders/([A-Za-z0-9_.-]{1,128})/(report\.html|plan\.json|animation\.gltf))",
-        [&d](const httplib::Request& req, httplib::Response& res) {
-          if (d.allowed(req, res)) d.serve_result(req.matches[1], req.matches[2], res);
-        });
-  s.Post("/orders", [&d](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
-    d.take_upload(req, res, content);
+    if (d.routes.allowed(req, res)) d.follow(res);
   });
   if (address.port == 0 ? (d.port = s.bind_to_any_port(address.host)) <= 0
                         : !s.bind_to_port(address.host, address.port)) {
@@ -292,11 +98,11 @@ Dashboard::~Dashboard() {
 
 int Dashboard::port() const { return impl_->port; }
 
-const std::string& Dashboard::token() const { return impl_->token; }
+const std::string& Dashboard::token() const { return impl_->routes.token(); }
 
 std::string Dashboard::url() const {
   const std::string host = impl_->host == "0.0.0.0" ? "127.0.0.1" : impl_->host;
-  return "http://" + host + ":" + std::to_string(impl_->port) + "/?token=" + impl_->token;
+  return "http://" + host + ":" + std::to_string(impl_->port) + "/?token=" + impl_->routes.token();
 }
 
 }  // namespace cellctl

@@ -30,9 +30,6 @@ class Dashboard {
   static constexpr int kOtherThreads = 24;
   static constexpr std::chrono::seconds kWriteTimeout{5};
   static constexpr std::chrono::seconds kReadTimeout{2};
-  static constexpr std::uintmax_t kMaxResultBytes = 256u << 20;  // an order's report, plan or animation
-  static constexpr std::uint64_t kMaxFormBytes = 64 * 1024;       // any request's body but an upload's
-  static constexpr int kMaxUploads = 2;                           // products being uploaded at once
 
   // Listens at once; throws with the reason when it cannot (the port is taken).
   Dashboard(const DashboardAddress& address, const CellConfig& cell, const CellObserver& observer);

@@ -3,6 +3,7 @@
 #include <openssl/rand.h>
 
 #include <algorithm>
+#include <vector>
 
 #include "deploy/cellctl/product_archive.hpp"
 #include "twin/description/automationml/automationml_description.hpp"
@@ -10,6 +11,18 @@
 
 namespace cellctl {
 namespace fs = std::filesystem;
+
+std::string random_hex(std::size_t bytes) {
+  std::vector<unsigned char> random(bytes);
+  if (RAND_bytes(random.data(), static_cast<int>(bytes)) != 1) throw std::runtime_error("no random bytes to be had");
+  static const char* hex = "0123456789abcdef";
+  std::string text;
+  for (unsigned char b : random) {
+    text += hex[b >> 4];
+    text += hex[b & 15];
+  }
+  return text;
+}
 
 bool good_order_id(const std::string& id) {
   return !id.empty() && id.size() <= 64 &&
@@ -32,25 +45,10 @@ std::string description_error(const fs::path& aml, const fs::path& folder) {
   }
 }
 
-namespace {
-
-std::string new_upload_id() {
-  unsigned char bytes[4];
-  if (RAND_bytes(bytes, sizeof bytes) != 1) throw std::runtime_error("no random bytes for an order's id");
-  static const char* hex = "0123456789abcdef";
-  std::string id = "upload-";
-  for (unsigned char b : bytes) {
-    id += hex[b >> 4];
-    id += hex[b & 15];
-  }
-  return id;
-}
-
-}  // namespace
 
 UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::string_view zip, std::string order,
                          const std::string& who) {
-  if (order.empty()) order = new_upload_id();
+  if (order.empty()) order = "upload-" + random_hex(4);
   if (!good_order_id(order)) return {400, "", "an order's id is 1 to 64 of A-Z, a-z, 0-9, ., _ and -"};
   const auto orders = store.orders();
   const auto under_way = std::count_if(orders.begin(), orders.end(), [](const auto& o) { return !o.ended(); });

@@ -13,6 +13,9 @@
 
 namespace cellctl {
 
+// `bytes` random bytes in hex: an id or a token no one guesses.
+std::string random_hex(std::size_t bytes);
+
 // 1 to 64 of A-Z, a-z, 0-9, '.', '_' and '-', not starting with '.'.
 bool good_order_id(const std::string& id);
 
