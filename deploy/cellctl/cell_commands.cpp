@@ -23,6 +23,7 @@
 #include "deploy/cellctl/dashboard.hpp"
 #include "deploy/cellctl/host_limits.hpp"
 #include "deploy/cellctl/order_desk.hpp"
+#include "deploy/cellctl/order_intake.hpp"
 #include "deploy/cellctl/processes.hpp"
 #include "deploy/cellctl/remote_desk.hpp"
 #include "deploy/cellctl/remote_submit.hpp"
@@ -644,6 +645,28 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       return;
     }
     std::cout << "cell on domain " << cell.domain << " stopped\n";
+  });
+
+  CLI::App* cancel = app.add_subcommand(
+      "cancel", "Cancel an order of the cell: a queued one never starts; one under way, its twin fails and cleans up");
+  add_cell_options(cancel, *cell_options);
+  auto cancelled = std::make_shared<std::string>();
+  cancel->add_option("order", *cancelled, "The order's id (cellctl status lists them)")->required();
+  cancel->callback([cell_options, cancelled, &exit_code] {
+    CellConfig cell = cell_options->load();
+    if (const std::string running = running_state_dir(cell.domain); !running.empty() && cell_options->state_dir.empty()) {
+      cell.state_dir = running;
+    }
+    if (!fs::exists(state::CellStore::file_in(cell.state_folder()))) {
+      std::cerr << "error: the cell keeps no state in " << cell.state_folder().string() << ": it has no order "
+                << *cancelled << '\n';
+      exit_code = 1;
+      return;
+    }
+    state::CellStore store(cell.state_folder());
+    const CancelAnswer answer = cancel_order(store, *cancelled, "the operator (cellctl)");
+    (answer.status == 200 ? std::cout : std::cerr) << (answer.status == 200 ? "" : "error: ") << answer.message << '\n';
+    exit_code = answer.status == 200 ? 0 : 1;
   });
 
   CLI::App* run = app.add_subcommand("run", "Start the cell, assemble one order per product at once, stop the cell");

@@ -190,6 +190,13 @@ void DashboardRoutes::install(httplib::Server& s) {
         [this](const httplib::Request& req, httplib::Response& res) {
           if (allowed(req, res)) serve_result(req.matches[1], req.matches[2], res);
         });
+  s.Post(R"(/orders/([A-Za-z0-9_.-]{1,128})/cancel)", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string order = req.matches[1];
+    state::CellStore store(cell_.state_folder());
+    const CancelAnswer answer = cancel_order(store, order, "the operator (dashboard)");
+    res.status = answer.status;
+    res.set_content(nlohmann::json{{"order", order}, {"message", answer.message}}.dump(), "application/json");
+  });
   s.Post("/orders", [this](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
     take_upload(req, res, content);
   });

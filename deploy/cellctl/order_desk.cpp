@@ -57,6 +57,15 @@ void OrderDesk::tend() {
   for (const state::OrderRecord& o : orders) {
     const std::string& id = o.order;
     if (o.ended() || twins_.count(id) || o.product.empty()) continue;  // no product: not the desk's order
+    // Cancelled before a twin took it: nothing of the cell is its yet, so the desk ends it. A
+    // twin that took it fails it itself, through the cleanup of any failure.
+    if (!o.cancelled_by.empty() && o.attempts == 0) {
+      const std::string why = "cancelled by " + o.cancelled_by + " before it started";
+      store_.set_order(id, "FAILED", why, 1);
+      store_.journal("cellctl", "cancelled", id, why);
+      log_("order " + id + " " + why);
+      continue;
+    }
     if (o.attempts == 0 && under_way >= cell_.max_twins) {
       ++place;
       if (o.state != "QUEUED") {

@@ -83,4 +83,16 @@ UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::s
   return {200, order, "order " + order + " (" + product + ") handed to the cell"};
 }
 
+CancelAnswer cancel_order(state::CellStore& store, const std::string& order, const std::string& who) {
+  const auto orders = store.orders();
+  const auto o = std::find_if(orders.begin(), orders.end(), [&](const auto& r) { return r.order == order; });
+  if (o == orders.end()) return {404, "the cell has no order " + order};
+  if (o->ended() || !store.request_cancel(order, who)) {
+    return {409, "order " + order + " has ended (" + o->state + "): there is nothing to cancel"};
+  }
+  store.journal(who, "cancel asked", order);
+  return {200, "cancel of order " + order + " asked: " +
+                   (o->attempts == 0 ? "it never starts" : "its twin fails it and cleans up within seconds")};
+}
+
 }  // namespace cellctl

@@ -1,8 +1,9 @@
 #pragma once
 // What every door of the cell's desk checks before an order is stored: the order's id, and
 // the product's description read whole (the errors `cellctl submit` gives, relative to the
-// product's folder: the sender knows its files by their names). And the dashboard's door: a
-// product uploaded as one zip (product_archive.hpp) becomes an order of the cell's.
+// product's folder: the sender knows its files by their names). The dashboard's door: a
+// product uploaded as one zip (product_archive.hpp) becomes an order of the cell's. And the
+// operator's cancel, from `cellctl cancel` and the dashboard alike.
 
 #include <filesystem>
 #include <string>
@@ -37,5 +38,14 @@ struct UploadAnswer {
 // `who` in the journal. `order` may be "": an id is made. A refusal keeps nothing.
 UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::string_view zip, std::string order,
                          const std::string& who);
+
+struct CancelAnswer {
+  int status = 200;  // as HTTP says it: 200 asked, 404 no such order, 409 it has ended
+  std::string message;
+};
+
+// Asks that the order be cancelled (CellStore::request_cancel), journalled with `who` ("the
+// operator (dashboard)"): its reason will read "cancelled by WHO".
+CancelAnswer cancel_order(state::CellStore& store, const std::string& order, const std::string& who);
 
 }  // namespace cellctl

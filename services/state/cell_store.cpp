@@ -33,7 +33,8 @@ CREATE TABLE IF NOT EXISTS orders(
   order_id TEXT PRIMARY KEY, state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '', updated REAL,
   product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', sequence TEXT NOT NULL DEFAULT '',
   path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0,
-  quote INTEGER NOT NULL DEFAULT 0, client TEXT NOT NULL DEFAULT '', request TEXT NOT NULL DEFAULT '');
+  quote INTEGER NOT NULL DEFAULT 0, client TEXT NOT NULL DEFAULT '', request TEXT NOT NULL DEFAULT '',
+  cancelled_by TEXT NOT NULL DEFAULT '');
 CREATE TABLE IF NOT EXISTS plan_steps(
   order_id TEXT NOT NULL, position INTEGER NOT NULL, step TEXT NOT NULL, trajectory TEXT NOT NULL,
   PRIMARY KEY(order_id, position));
@@ -185,6 +186,7 @@ void CellStore::add_columns_of_later_versions() {
     exec("ALTER TABLE orders ADD COLUMN client TEXT NOT NULL DEFAULT ''; "
          "ALTER TABLE orders ADD COLUMN request TEXT NOT NULL DEFAULT ''");
   }
+  if (!has("orders", "cancelled_by")) exec("ALTER TABLE orders ADD COLUMN cancelled_by TEXT NOT NULL DEFAULT ''");
   if (!has("parts", "from_kept")) {
     // A give under way when the cell was upgraded is undone as before: kept for its order again.
     exec("ALTER TABLE parts ADD COLUMN from_kept INTEGER NOT NULL DEFAULT 0; "
@@ -507,6 +509,19 @@ void CellStore::set_order(const std::string& order, const std::string& state, co
       .step();
 }
 
+bool CellStore::request_cancel(const std::string& order, const std::string& who) {
+  Statement(db_, "UPDATE orders SET cancelled_by = ? WHERE order_id = ? AND state NOT IN ('DONE', 'FAILED')")
+      .bind(who, order)
+      .step();
+  return sqlite3_changes(db_) > 0;
+}
+
+std::string CellStore::cancel_requested(const std::string& order) const {
+  Statement row(db_, "SELECT cancelled_by FROM orders WHERE order_id = ?");
+  row.bind(order);
+  return row.step() ? row.text(0) : "";
+}
+
 int CellStore::count_attempt(const std::string& order) {
   Transaction t(*this);
   Statement(db_, "UPDATE orders SET attempts = attempts + 1 WHERE order_id = ?").bind(order).step();
@@ -519,12 +534,12 @@ int CellStore::count_attempt(const std::string& order) {
 
 std::vector<OrderRecord> CellStore::orders() const {
   Statement rows(db_, "SELECT order_id, state, reason, product, out_dir, sequence, path_planner, IFNULL(exit_code, -1), "
-                      "attempts, quote, client, request, rowid FROM orders ORDER BY rowid");
+                      "attempts, quote, client, request, rowid, cancelled_by FROM orders ORDER BY rowid");
   std::vector<OrderRecord> out;
   while (rows.step()) {
     out.push_back({rows.text(0), rows.text(1), rows.text(2), rows.text(3), rows.text(4), rows.text(5), rows.text(6),
                    static_cast<int>(rows.integer(7)), static_cast<int>(rows.integer(8)), rows.integer(9) != 0,
-                   rows.text(10), rows.text(11), rows.integer(12)});
+                   rows.text(10), rows.text(11), rows.integer(12), rows.text(13)});
   }
   return out;
 }

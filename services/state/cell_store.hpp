@@ -69,6 +69,8 @@ struct OrderRecord {
   // after a restart of cellctl up); "" for a local one.
   std::string client{}, request{};
   long arrival = 0;    // the order's place in the cell's arrival order (its row; set by the store)
+  // Who asked to cancel it ("dashboard", "cellctl"); "" while nobody did (request_cancel).
+  std::string cancelled_by{};
   bool ended() const;  // DONE or FAILED
 };
 
@@ -159,6 +161,12 @@ class CellStore {
   // A new order, SUBMITTED; false when an order of that id exists.
   bool submit_order(const OrderRecord& order);
   void set_order(const std::string& order, const std::string& state, const std::string& reason = "", int exit_code = -1);
+  // Asks that the order be cancelled (its twin fails it with "cancelled by WHO", through the
+  // cleanup any failure takes; an order no twin has started is failed by the cell's desk).
+  // False when the cell has no such order or it has ended.
+  bool request_cancel(const std::string& order, const std::string& who);
+  // Who asked to cancel the order; "" when nobody did.
+  std::string cancel_requested(const std::string& order) const;
   // One more twin started for the order; the attempts so far.
   int count_attempt(const std::string& order);
   std::vector<OrderRecord> orders() const;  // in the order they came

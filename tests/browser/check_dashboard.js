@@ -2,7 +2,7 @@
 // `cellctl up --dashboard` on a domain of its own, opens the address it printed, and checks
 // what a person would see: every resource of the cell; a file that is not a product's zip
 // refused with the reason; an order submitted through the page's form (the product's zip)
-// advancing to DONE, its report opening from the page's link; a killed buffer turning gone,
+// advancing to DONE, its report opening from the page's link; one cancelled from its row; a killed buffer turning gone,
 // then back; no console error; no request
 // to anything but the dashboard. Prints the page's update latency (a DDS event heard by
 // cellctl up to the page's state drawn, p50 and p99) and can keep a screenshot of the page at
@@ -163,6 +163,23 @@ function percentile(values, p) {
         buffer + " did not turn gone and back: it went " + JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], buffer))));
       const alarms = await page.$$eval("#alarms li", (lis) => lis.map((li) => li.textContent));
       if (!alarms.some((a) => a.includes(buffer) && a.includes("restarted"))) problems.push("no alarm says " + buffer + " restarted");
+    }
+    // The operator cancels an order from its row (the page asks first): it fails with the reason.
+    page.on("dialog", (d) => d.accept());
+    const again = await upload(productZip, "dash-c");
+    if (again.cls !== "answer-ok") problems.push("the product's zip was not taken again: " + JSON.stringify(again));
+    const cancel = await page.waitForFunction(() => {
+      const row = [...document.querySelectorAll("#orders tbody tr")].find((tr) => tr.cells[0].textContent === "dash-c");
+      return row && row.querySelector("button.cancel");
+    }, { timeout: 20000 }).catch(() => null);
+    if (!cancel) {
+      problems.push("dash-c has no cancel button");
+    } else {
+      await cancel.asElement().click();
+      await shows("dash-c", "FAILED").catch(() => problems.push("dash-c, cancelled, never showed FAILED"));
+      const reason = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-c")
+        .map((tr) => tr.cells[5].textContent).join(""));
+      if (!reason.startsWith("cancelled by the operator (dashboard)")) problems.push("dash-c failed for another reason: " + reason);
     }
     const drawn = await page.evaluate(() => document.body.dataset.scene);
     if (drawn !== "drawn") problems.push("the 3D view was not drawn");

@@ -168,8 +168,8 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
   CHECK(up.wait_for_exit(20s) == 0);
 }
 
-TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes an order of the cell's; a stranger's, "
-          "another site's, a hostile or a bad one is refused with the reason, and nothing is kept",
+TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes an order of the cell's, and the operator "
+          "cancels one; a stranger's, another site's, a hostile or a bad one is refused with the reason, and nothing is kept",
           "[process][cell][dashboard]") {
   using namespace std::chrono_literals;
   namespace fs = std::filesystem;
@@ -243,18 +243,42 @@ TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes a
   const std::string made = nlohmann::json::parse(r->body)["order"];
   CHECK(made.rfind("upload-", 0) == 0);
 
-  // Both show on the page's state.
-  bool shown = false;
-  for (auto until = std::chrono::steady_clock::now() + 20s; !shown && std::chrono::steady_clock::now() < until;
+  // The operator cancels the second: a stranger, another site and an unknown order cannot.
+  const std::string cancel = "/orders/" + made + "/cancel";
+  r = client.Post(cancel.c_str());
+  REQUIRE(r);
+  CHECK(r->status == 401);
+  r = client.Post(cancel.c_str(), foreign, "", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 403);
+  r = client.Post("/orders/nope/cancel", bearer, "", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 404);
+  r = client.Post(cancel.c_str(), bearer, "", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+
+  // Both show on the page's state: the first done, the second failed as cancelled.
+  std::string first, second;
+  for (auto until = std::chrono::steady_clock::now() + 90s;
+       !(first == "DONE" && second == "FAILED") && std::chrono::steady_clock::now() < until;
        std::this_thread::sleep_for(200ms)) {
     r = client.Get("/state", bearer);
     REQUIRE(r);
     const auto state = nlohmann::json::parse(r->body);
-    int found = 0;
-    for (const auto& o : state["orders"]) found += o["order"] == "o-1" || o["order"] == made;
-    shown = found == 2;
+    for (const auto& o : state["orders"]) {
+      if (o["order"] == "o-1") first = o["state"];
+      if (o["order"] == made && o["state"] == "FAILED") {
+        second = "FAILED";
+        CHECK(o["reason"].get<std::string>().rfind("cancelled by the operator (dashboard)", 0) == 0);
+      }
+    }
   }
-  CHECK(shown);
+  CHECK(first == "DONE");
+  CHECK(second == "FAILED");
+  r = client.Post(cancel.c_str(), bearer, "", "text/plain");  // it has ended
+  REQUIRE(r);
+  CHECK(r->status == 409);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }

@@ -134,3 +134,79 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
   CHECK(up->wait_for_exit(30s) == 0);
 }
+
+TEST_CASE("cancel: a queued order never starts, one in physical assembly fails with the reason and holds nothing, "
+          "and the cell builds the next", "[process][cell][desk]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("cancel"), state = dir / "state";
+  const std::string domain = "172";
+  std::string yaml = test::read_text(DEFAULT_CELL);
+  yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: 1");
+  const fs::path cell = dir / "cell.yaml";
+  std::ofstream(cell) << yaml;
+  test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
+                         "--state-dir", state.string()},
+                        (dir / "up.log").string());
+  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+  const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+  const auto detach = [&](const std::string& id) {
+    return test::cellctl({"submit", "--detach", product, "--cell", cell.string(), "--domain", domain, "--order", id, "--out",
+                          (dir / id).string()},
+                         dir / (id + ".log"), 30s);
+  };
+  const auto cancel = [&](const std::string& id) {
+    return test::cellctl({"cancel", id, "--cell", cell.string(), "--domain", domain}, dir / ("cancel-" + id + ".log"), 30s);
+  };
+  const auto record = [&](const std::string& id) {
+    for (const auto& o : state::CellStore(state).orders()) {
+      if (o.order == id) return o;
+    }
+    return state::OrderRecord{};
+  };
+  const auto ends = [&](const std::string& id, std::chrono::seconds timeout) {
+    for (auto until = std::chrono::steady_clock::now() + timeout; std::chrono::steady_clock::now() < until;
+         std::this_thread::sleep_for(100ms)) {
+      if (record(id).ended()) return true;
+    }
+    return false;
+  };
+
+  REQUIRE(detach("c1") == 0);
+  REQUIRE(detach("c2") == 0);
+  REQUIRE(journaled(state, "queued", "c2", 30s));
+  CHECK(cancel("c2") == 0);
+  CHECK(test::read_text(dir / "cancel-c2.log").find("it never starts") != std::string::npos);
+  REQUIRE(ends("c2", 30s));
+  CHECK(record("c2").state == "FAILED");
+  CHECK(record("c2").reason == "cancelled by the operator (cellctl) before it started");
+  CHECK(record("c2").attempts == 0);
+
+  // c1 once its first part is in the arm's gripper.
+  bool gripping = false;
+  for (auto until = std::chrono::steady_clock::now() + 120s; !gripping && std::chrono::steady_clock::now() < until;
+       std::this_thread::sleep_for(50ms)) {
+    const auto parts = state::CellStore(state).parts("c1");
+    gripping = std::any_of(parts.begin(), parts.end(), [](const state::PartRecord& p) { return p.place == state::Place::in_gripper; });
+  }
+  REQUIRE(gripping);
+  CHECK(cancel("c1") == 0);
+  REQUIRE(ends("c1", 60s));
+  INFO(test::error_lines(test::read_text(dir / "up.log")));
+  CHECK(record("c1").state == "FAILED");
+  CHECK(record("c1").reason == "cancelled by the operator (cellctl)");
+  CHECK(cancel("c1") == 1);  // ended: nothing to cancel
+  CHECK(test::read_text(dir / "cancel-c1.log").find("has ended") != std::string::npos);
+  CHECK(cancel("nope") == 1);
+  CHECK(test::read_text(dir / "cancel-nope.log").find("no order nope") != std::string::npos);
+
+  // Nothing of c1 holds the station: the next order is built.
+  REQUIRE(detach("c3") == 0);
+  REQUIRE(ends("c3", 120s));
+  CHECK(record("c3").state == "DONE");
+  for (const auto& [type, c] : state::CellStore(state).inventory()) {
+    INFO(type);
+    CHECK(c.initial == c.accounted());
+  }
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
+  CHECK(up.wait_for_exit(30s) == 0);
+}

@@ -180,6 +180,37 @@ TEST_CASE("an order's plan is stored whole and replaced whole, and kept across a
   CHECK(again.plan_of("o2") == std::vector<state::PlanStepRecord>{{"b1", "down"}});
 }
 
+TEST_CASE("a cancel is asked of an order that has not ended, and says who asked; an older database gets the column",
+          "[state]") {
+  const auto dir = fresh_dir("cancel");
+  {
+    // A database of a cell from before cancels: its orders table without the column.
+    fs::create_directories(dir);
+    sqlite3* db = nullptr;
+    REQUIRE(sqlite3_open(state::CellStore::file_in(dir).c_str(), &db) == SQLITE_OK);
+    REQUIRE(sqlite3_exec(db, "CREATE TABLE orders(order_id TEXT PRIMARY KEY, state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '', "
+                             "updated REAL, product TEXT NOT NULL DEFAULT '', out_dir TEXT NOT NULL DEFAULT '', "
+                             "sequence TEXT NOT NULL DEFAULT '', path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, "
+                             "attempts INTEGER NOT NULL DEFAULT 0); "
+                             "INSERT INTO orders(order_id, state) VALUES('old', 'QUEUED')",
+                         nullptr, nullptr, nullptr) == SQLITE_OK);
+    sqlite3_close(db);
+  }
+  state::CellStore store(dir);
+  CHECK(store.cancel_requested("old").empty());
+  CHECK(store.request_cancel("old", "the operator (cellctl)"));
+  CHECK(store.cancel_requested("old") == "the operator (cellctl)");
+  CHECK_FALSE(store.request_cancel("nope", "the operator (cellctl)"));
+  REQUIRE(store.submit_order({"done", "", "", "p.aml", "out", "search", "linear"}));
+  store.set_order("done", "DONE", "", 0);
+  CHECK_FALSE(store.request_cancel("done", "the operator (dashboard)"));
+  CHECK(store.cancel_requested("done").empty());
+  const auto orders = store.orders();
+  REQUIRE(orders.size() == 2);
+  CHECK(orders[0].cancelled_by == "the operator (cellctl)");
+  CHECK(orders[1].cancelled_by.empty());
+}
+
 TEST_CASE("the commands a resource had taken on are answered once by the process after it", "[state]") {
   state::CellStore store(fresh_dir("commands"));
   store.command_taken({"robot-1", "o1/c1", "o1", "fetch", "o1/peg"});

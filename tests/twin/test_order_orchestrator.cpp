@@ -86,6 +86,7 @@ struct Cell {
   std::function<std::string(const Data&)> refuse = [](const Data&) { return std::string(); };
   std::function<std::string(const Data&)> refuse_call = [](const Data&) { return std::string(); };  // a CFP
   std::function<bool(const Data&)> busy = [](const Data&) { return false; };  // cell-sim's queue full
+  std::function<bool(const fb::Event&)> stop_before = [](const fb::Event&) { return false; };  // the operator cancels
   long ahead = 0;
   std::string turns_ours = "station-1";
   int ticks = 0;
@@ -130,6 +131,10 @@ Outcome run(Twin& t, const Cell& cell) {
     }
     const fb::Event e = pending.front();
     pending.erase(pending.begin());
+    if (cell.stop_before(e)) {
+      const auto stopped = t.send("orchestrator", "STOP", {{"reason", std::string("cancelled by the operator (test)")}});
+      pending.insert(pending.end(), stopped.begin(), stopped.end());
+    }
     std::vector<fb::Event> more;
     if (e.name == "CFP") {
       const std::string& op = get<std::string>(e.data, "operation");
@@ -468,6 +473,31 @@ TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not 
   std::sort(unanswered.begin(), unanswered.end());
   CHECK(out.canceled == unanswered);  // both in the order of their ids
   CHECK(unanswered.size() == lego.plan.steps.size() - 2);
+}
+
+TEST_CASE("orchestrator: an order the operator cancels in physical assembly fails with that reason, cancels its fetches and "
+          "releases what it holds", "[twin][orchestration]") {
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
+  Twin t(lego.product, lego.plan);
+  Cell cell;
+  int fetches = 0, grips = 0;
+  cell.refuse = [&](const Data& c) -> std::string {
+    if (get<std::string>(c, "operation") == "fetch" && ++fetches > 2) return kAcceptOnly;  // the rest not yet delivered
+    return "";
+  };
+  cell.stop_before = [&](const fb::Event& e) {
+    return e.name == "COMMAND" && get<std::string>(e.data, "operation") == "grip" && ++grips == 2;
+  };
+  const Outcome out = run(t, cell);
+  CHECK(out.finished);
+  CHECK_FALSE(out.complete);
+  CHECK(out.error == "cancelled by the operator (test)");
+  REQUIRE_FALSE(out.statuses.empty());
+  CHECK(out.statuses.back() == "cancelled by the operator (test)");
+  CHECK(out.canceled.size() == lego.plan.steps.size() - 2);
+  for (const char* held : {"RELEASE station-1", "RELEASE arm-1", "RELEASE mobile-robot-1"}) {
+    CHECK(std::count(out.order.begin(), out.order.end(), held) == 1);
+  }
 }
 
 TEST_CASE("orchestrator: the next fetch goes once the robot heard the last, so a resent one is not overtaken", "[twin][orchestration]") {

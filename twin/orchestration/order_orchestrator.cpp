@@ -22,6 +22,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       settings_(std::move(settings)), sim_(settings_.order_id), booking_(settings_.order_id) {
   declare_input("START");
   declare_input("TICK");
+  declare_input("STOP", {"reason"});
   declare_input("CAPABILITY", {"resource_id", "kind", "position", "dock", "speed", "angular_speed", "reserved_by",
                                "waiting"});
   declare_input("RESOURCE_GONE", {"resource_id"});
@@ -185,6 +186,8 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   for (const Phase in : {Phase::waiting_cell, Phase::virtual_assembly, Phase::booking, Phase::queued, Phase::hiring,
                          Phase::physical, Phase::quoting}) {
     transition(in, "FAILED", Phase::cleanup, [this](const Data&) { plan_cleanup(); });
+    // The operator cancelled the order: a failure like any other, with that reason.
+    transition(in, "STOP", in, [this](const Data& d) { fail(get<std::string>(d, "reason")); });
   }
   transition(Phase::physical, "TAKE_UP", Phase::ended, [this](const Data&) {
     emit("FINISHED", {{"complete", false}, {"error", error_}, {"take_up", true}});

@@ -50,13 +50,15 @@
 //   QUOTING       -PRICED->         ENDED      the quote (QUOTE), FINISHED
 //   PHYSICAL      -PHYSICAL_DONE->  CLEANUP
 //   any but CLEANUP and ENDED -FAILED-> CLEANUP;  PHYSICAL -TAKE_UP-> ENDED (FINISHED, take_up)
+//   any but IDLE, CLEANUP and ENDED -STOP (reason)-> a failure with that reason (the operator
+//                cancelled the order), so -FAILED-> CLEANUP
 //   CLEANUP       -CLEANED->        ENDED      the bodies removed, or the cleanup's time out
 //
 // No hold-and-wait: while it waits for a station the order holds nothing; once it holds a
 // station, everything else it needs is shared (robots, buffers) or belongs to that station
 // (its arm), so every wait is bounded.
 //
-//   inputs: START, TICK, CAPABILITY (resource_id, kind, position, dock, speed, angular_speed,
+//   inputs: START, TICK, STOP (reason), CAPABILITY (resource_id, kind, position, dock, speed, angular_speed,
 //           reserved_by, waiting), RESOURCE_GONE (resource_id), AWARDED (call_id,
 //           resource_id, ahead), QUOTED (call_id, resource_id, earliest_start, duration, bid_time),
 //           UNAVAILABLE (call_id, reason), COMMAND_EVENT (command_id,

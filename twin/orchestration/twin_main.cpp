@@ -426,13 +426,23 @@ class TwinProcess {
                              " s: is the cell up on domain " + std::to_string(options_.dds.domain_id) + "?");
     }
     r.post("orchestrator", "START");
-    auto last_tick = std::chrono::steady_clock::now();
+    auto last_tick = std::chrono::steady_clock::now(), last_look = last_tick;
+    bool cancelled = false;
     while (!finished && running) {
       r.wait_and_run_one(std::chrono::milliseconds(50));
-      if (std::chrono::steady_clock::now() - last_tick > std::chrono::milliseconds(100)) {
-        last_tick = std::chrono::steady_clock::now();
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_tick > std::chrono::milliseconds(100)) {
+        last_tick = now;
         r.post("orchestrator", "TICK");
         r.post("negotiator", "TICK");
+      }
+      // Whether the operator cancelled the order (cellctl cancel, the dashboard): once a second.
+      if (store_ && !cancelled && now - last_look > std::chrono::seconds(1)) {
+        last_look = now;
+        if (const std::string who = store_->cancel_requested(options_.order); !who.empty()) {
+          cancelled = true;
+          r.post("orchestrator", "STOP", {{"reason", "cancelled by " + who}});
+        }
       }
     }
     services::ExitWatchdog watchdog(std::chrono::seconds(30));  // ends us if the DDS entities' teardown hangs

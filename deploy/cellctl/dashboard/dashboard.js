@@ -68,9 +68,27 @@
           results.append(a, " ");
         }
       }
+      if (o.state !== "DONE" && o.state !== "FAILED") results.append(cancelButton(o.order));
       return [o.order + (o.quote ? " (quote)" : ""), el("span", o.state, "state-" + o.state), bar, o.place ?? "",
               o.message || "", o.reason || "", results];
     }));
+  }
+  // One button per order, kept across redraws: a click between two states still lands.
+  const cancelButtons = new Map();
+  function cancelButton(order) {
+    if (cancelButtons.has(order)) return cancelButtons.get(order);
+    const button = el("button", "cancel", "cancel");
+    button.addEventListener("click", async () => {
+      if (!window.confirm("Cancel order " + order + "? Its twin fails it and the cell cleans up.")) return;
+      button.disabled = true;
+      const response = await fetch("/orders/" + encodeURIComponent(order) + "/cancel", { method: "POST" })
+        .catch((error) => ({ ok: false, text: async () => JSON.stringify({ message: error.message }) }));
+      const answer = document.getElementById("submit-answer");
+      answer.textContent = await messageOf(response);
+      answer.className = response.ok ? "answer-ok" : "answer-refused";
+    });
+    cancelButtons.set(order, button);
+    return button;
   }
   function renderInventory(inventory) {
     fill(document.querySelector("#inventory tbody"), Object.entries(inventory).map(([type, c]) => [
@@ -234,6 +252,11 @@
     });
   }
 
+  // What the cell answered an action: its JSON's message, or its plain text.
+  async function messageOf(response) {
+    const text = await response.text();
+    try { return JSON.parse(text).message; } catch (ignored) { return text; }
+  }
   // An order from a product's zip, through the cell's desk (POST /orders): the answer, or the
   // refusal's reason, under the form.
   function takeOrders() {
@@ -250,10 +273,7 @@
       try {
         const response = await fetch("/orders" + (id ? "?order=" + encodeURIComponent(id) : ""),
                                      { method: "POST", body: file, headers: { "Content-Type": "application/zip" } });
-        const text = await response.text();
-        let message = text;
-        try { message = JSON.parse(text).message; } catch (ignored) { /* a plain-text answer */ }
-        answer.textContent = message;
+        answer.textContent = await messageOf(response);
         answer.className = response.ok ? "answer-ok" : "answer-refused";
         if (response.ok) form.reset();
       } catch (error) {
