@@ -130,8 +130,11 @@ httplib::Server::HandlerResponse DashboardRoutes::before_body(const httplib::Req
 
 // POST /orders[?order=ID], the body a product's zip: an order, as `cellctl submit` makes one.
 void DashboardRoutes::take_upload(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
+  struct Counted {  // this upload among those under way, until it is answered (or throws)
+    std::atomic<int>& n;
+    ~Counted() { --n; }
+  } counted{uploads_};
   if (++uploads_ > kMaxUploads) {
-    --uploads_;
     res.status = 503;
     res.set_content(std::to_string(kMaxUploads) + " uploads are under way; send this one when they are done\n", "text/plain");
     return;
@@ -153,13 +156,12 @@ void DashboardRoutes::take_upload(const httplib::Request& req, httplib::Response
       answer = cellctl::take_upload(cell_, store, zip, req.get_param_value("order"), "dashboard");
     }
   }
-  --uploads_;
   res.status = answer.status;
   res.set_content(nlohmann::json{{"order", answer.order}, {"message", answer.message}}.dump(), "application/json");
 }
 
 std::size_t DashboardRoutes::max_upload_bytes() const {
-return static_cast<std::size_t>(cell_.desk.max_order_mb * 1e6) + (1u << 20);  // a zip's own bytes over its files'
+  return static_cast<std::size_t>(cell_.desk.max_order_mb * 1e6) + (1u << 20);  // a zip's own bytes over its files'
 }
 
 void DashboardRoutes::install(httplib::Server& s) {

@@ -74,10 +74,15 @@ UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::s
     fs::remove_all(folder, ignored);
     return UploadAnswer{status, "", why};
   };
-  if (const std::string error = description_error(aml, folder / "product"); !error.empty()) return refuse(400, error);
-  fs::create_directories(folder / "out");
-  state::OrderRecord record{order, "", "", aml.string(), (folder / "out").string(), "search", "linear"};
-  if (!store.submit_order(record)) return refuse(409, "the cell has an order " + order + " already: give this one another id");
+  try {
+    if (const std::string error = description_error(aml, folder / "product"); !error.empty()) return refuse(400, error);
+    fs::create_directories(folder / "out");
+    state::OrderRecord record{order, "", "", aml.string(), (folder / "out").string(), "search", "linear"};
+    if (!store.submit_order(record)) return refuse(409, "the cell has an order " + order + " already: give this one another id");
+  } catch (...) {
+    refuse(500, "");
+    throw;
+  }
   const std::string product = aml.lexically_relative(folder / "product").string();
   store.journal(who, "submitted", order, product + ", " + std::to_string(zip.size()) + " bytes uploaded");
   return {200, order, "order " + order + " (" + product + ") handed to the cell"};

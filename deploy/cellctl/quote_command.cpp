@@ -25,7 +25,7 @@ using nlohmann::json;
 namespace {
 
 std::atomic<bool> stop_quoting{false};  // set by a signal handler
-void request_stop(int) { stop_quoting = true; }
+void stop_quoting_on_signal(int) { stop_quoting = true; }
 
 struct QuoteOptions {
   std::string product, client, out = "quotes", json_file, sequence = "search";
@@ -75,7 +75,7 @@ int run_quotes(const QuoteOptions& o) {
                                      std::chrono::seconds(static_cast<long>(o.wait_s)), true, "[" + a->name + "] "};
     asked.push_back(std::move(a));
   }
-  std::signal(SIGINT, request_stop);
+  std::signal(SIGINT, stop_quoting_on_signal);
   {
     std::vector<std::thread> threads;
     for (auto& a : asked) {

@@ -20,6 +20,13 @@ class EventRecorder : public FunctionBlock {
   std::vector<Event> events;
 };
 
+// The events' names, in order: what a test compares.
+inline std::vector<std::string> event_names(const std::vector<Event>& events) {
+  std::vector<std::string> out;
+  for (const auto& e : events) out.push_back(e.name);
+  return out;
+}
+
 template <class Block>
 class BlockTestFixture {
  public:
@@ -41,11 +48,6 @@ class BlockTestFixture {
     return recorder_->events;
   }
 
-  static std::vector<std::string> names(const std::vector<Event>& events) {
-    std::vector<std::string> out;
-    for (const auto& e : events) out.push_back(e.name);
-    return out;
-  }
 
  private:
   Resource resource_;

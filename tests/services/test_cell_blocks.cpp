@@ -23,11 +23,6 @@
 namespace {
 
 using Names = std::vector<std::string>;
-template <class B>
-Names names(const std::vector<fb::Event>& events) {
-  return fb::BlockTestFixture<B>::names(events);
-}
-
 fb::Data command(const std::string& id, const std::string& operation, fb::Data extra = {}) {
   extra["command_id"] = id;
   extra["resource_id"] = std::string("arm-1");
@@ -48,7 +43,7 @@ TEST_CASE("arm: a grip places palm, fingers and carriage, a second grip replaces
   const fb::Data grasp{{"part", std::string("o1/B1")}, {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
   for (int round = 0; round < 2; ++round) {
     const std::string id = "g" + std::to_string(round);
-    CHECK(names<fb::ArmBlock>(f.send("COMMAND", command(id, "grip", grasp))) == Names{"ACCEPT"});
+    CHECK(fb::event_names(f.send("COMMAND", command(id, "grip", grasp))) == Names{"ACCEPT"});
     const auto requests = f.send("START", {{"command_id", id}});
     REQUIRE(requests.size() == (round == 0 ? 4u : 8u));
     // The fingers stand 20 mm apart, on either side of the gripper's origin.
@@ -56,7 +51,7 @@ TEST_CASE("arm: a grip places palm, fingers and carriage, a second grip replaces
     CHECK(fb::get<std::string>(finger, "body_id") == "arm-1/finger-1");
     CHECK(fb::get<fb::Numbers>(finger, "placement")[0] == Approx(-0.01 - fb::GripperGeometry{}.finger_thickness / 2));
     for (std::size_t i = 0; i + 1 < requests.size(); ++i) CHECK(f.send("SIM_REPLY", reply_to(requests[i])).empty());
-    CHECK(names<fb::ArmBlock>(f.send("SIM_REPLY", reply_to(requests.back()))) == Names{"DONE"});
+    CHECK(fb::event_names(f.send("SIM_REPLY", reply_to(requests.back()))) == Names{"DONE"});
   }
   CHECK(f.block().held() == "o1/B1");
 }
@@ -79,12 +74,12 @@ TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part un
   };
   const fb::Data grasp{{"part", std::string("o1/base")}, {"carried", fb::join_names({"o1/m1", "o1/m2"})},
                        {"order_id", std::string("o1")}, {"path", fb::Numbers{0, 0.1, 0, 1, 0, 0, 0}}, {"opening", 0.02}};
-  REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("g", "grip", grasp))) == Names{"ACCEPT"});
+  REQUIRE(fb::event_names(f.send("COMMAND", command("g", "grip", grasp))) == Names{"ACCEPT"});
   const auto spawns = f.send("START", {{"command_id", std::string("g")}});
   for (const auto& request : spawns) f.send("SIM_REPLY", reply_to(request));
   CHECK(f.block().carried() == std::vector<std::string>{"o1/m1", "o1/m2"});
   const auto move_of = [&](const std::string& id) {
-    REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command(id, "translate", {{"path", fb::Numbers{0, 0.2, 0, 1, 0, 0, 0}}}))) ==
+    REQUIRE(fb::event_names(f.send("COMMAND", command(id, "translate", {{"path", fb::Numbers{0, 0.2, 0, 1, 0, 0, 0}}}))) ==
             Names{"ACCEPT"});
     const auto out = f.send("START", {{"command_id", id}});
     REQUIRE(out.size() == 1);
@@ -97,7 +92,7 @@ TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part un
   CHECK(places() == std::set<std::string>{"in_gripper:arm-1"});
   // The release says what the parts go into: the state records them placed with it, in one
   // transaction (a twin that dies right after cannot leave them "at the dock").
-  REQUIRE(names<fb::ArmBlock>(f.send("COMMAND", command("r", "release", {{"order_id", std::string("o1")},
+  REQUIRE(fb::event_names(f.send("COMMAND", command("r", "release", {{"order_id", std::string("o1")},
                                                                          {"destination", std::string("product")}}))) ==
           Names{"ACCEPT"});
   f.send("START", {{"command_id", std::string("r")}});
@@ -111,7 +106,7 @@ TEST_CASE("arm: a grip naming carried bodies moves them with the gripped part un
 TEST_CASE("mobile robot: drive to the buffer, ask it, drive to the station carrying the part", "[fb][mobile-robot]") {
   fb::BlockTestFixture<fb::MobileRobotBlock> f("robot", "robot-1", fb::Numbers{1, 0, 1}, 0.5);
   const auto spawn = f.send("INIT");
-  REQUIRE(names<fb::MobileRobotBlock>(spawn) == Names{"SIM"});
+  REQUIRE(fb::event_names(spawn) == Names{"SIM"});
   f.send("SIM_REPLY", reply_to(spawn[0]));
   f.send("PLACE", {{"resource_id", std::string("buffer-1")}, {"dock", fb::Numbers{2, 0, 0}}});
   f.send("PLACE", {{"resource_id", std::string("station-1")}, {"dock", fb::Numbers{0.6, 0, 0}}});
@@ -120,15 +115,15 @@ TEST_CASE("mobile robot: drive to the buffer, ask it, drive to the station carry
                  {"part", std::string("o1/peg")}, {"part_type", std::string("Peg")},
                  {"source", std::string("buffer-1")}, {"destination", std::string("station-1")},
                  {"source_award", std::string("o1/give/Peg")}};
-  REQUIRE(names<fb::MobileRobotBlock>(f.send("COMMAND", fetch)) == Names{"ACCEPT"});
+  REQUIRE(fb::event_names(f.send("COMMAND", fetch)) == Names{"ACCEPT"});
   const auto to_buffer = f.send("START", {{"command_id", std::string("f1")}});
-  REQUIRE(names<fb::MobileRobotBlock>(to_buffer) == Names{"SIM"});
+  REQUIRE(fb::event_names(to_buffer) == Names{"SIM"});
   CHECK(fb::get<std::string>(to_buffer[0].data, "kind") == "move");
   CHECK(fb::get<fb::Numbers>(to_buffer[0].data, "path") == fb::Numbers{2, 0, 0, 1, 0, 0, 0});
   CHECK(fb::get<std::string>(to_buffer[0].data, "carried").empty());
 
   const auto give = f.send("SIM_REPLY", reply_to(to_buffer[0], {{"start_time", 1.0}, {"end_time", 3.0}, {"distance", 1.0}}));
-  REQUIRE(names<fb::MobileRobotBlock>(give) == Names{"GIVE"});
+  REQUIRE(fb::event_names(give) == Names{"GIVE"});
   CHECK(fb::get<std::string>(give[0].data, "resource_id") == "buffer-1");
   CHECK(fb::get<std::string>(give[0].data, "part_type") == "Peg");
   CHECK(fb::get<std::string>(give[0].data, "award") == "o1/give/Peg");  // the buffer's award, for the buffer
@@ -136,10 +131,10 @@ TEST_CASE("mobile robot: drive to the buffer, ask it, drive to the station carry
                               {"reason", std::string()}}).empty());
   const auto to_station = f.send("GIVE_EVENT", {{"command_id", fb::get<std::string>(give[0].data, "command_id")},
                                                 {"state", std::string("succeeded")}, {"reason", std::string()}});
-  REQUIRE(names<fb::MobileRobotBlock>(to_station) == Names{"SIM"});
+  REQUIRE(fb::event_names(to_station) == Names{"SIM"});
   CHECK(fb::get<std::string>(to_station[0].data, "carried") == "o1/peg");
   const auto done = f.send("SIM_REPLY", reply_to(to_station[0], {{"start_time", 3.5}, {"end_time", 6.3}, {"distance", 1.4}}));
-  REQUIRE(names<fb::MobileRobotBlock>(done) == Names{"DONE"});
+  REQUIRE(fb::event_names(done) == Names{"DONE"});
   CHECK(fb::get<double>(done[0].data, "distance") == Approx(2.4));
   CHECK(fb::get<double>(done[0].data, "duration") == Approx(4.8));  // moving only, not waiting for the buffer
   CHECK(fb::get<double>(done[0].data, "sim_time") == 6.3);
@@ -152,9 +147,9 @@ TEST_CASE("mobile robot: a buffer that refuses fails the fetch with its reason",
                  {"operation", std::string("fetch")}, {"source", std::string("buffer-9")},
                  {"destination", std::string("station-1")}, {"part_type", std::string("Peg")},
                  {"source_award", std::string("o1/give/Peg")}};
-  REQUIRE(names<fb::MobileRobotBlock>(f.send("COMMAND", fetch)) == Names{"ACCEPT"});
+  REQUIRE(fb::event_names(f.send("COMMAND", fetch)) == Names{"ACCEPT"});
   const auto unknown = f.send("START", {{"command_id", std::string("f1")}});
-  REQUIRE(names<fb::MobileRobotBlock>(unknown) == Names{"FAIL"});
+  REQUIRE(fb::event_names(unknown) == Names{"FAIL"});
   CHECK(fb::get<std::string>(unknown[0].data, "reason") == "no dock known for buffer-9 or station-1");
   CHECK(f.block().state() == "READY");
 }
@@ -175,21 +170,21 @@ TEST_CASE("mobile robot: a give goes again, the same command, until its final an
   f.send("COMMAND", fetch);
   const auto to_buffer = f.send("START", {{"command_id", std::string("f1")}});
   const auto give = f.send("SIM_REPLY", reply_to(to_buffer[0], {{"start_time", 1.0}, {"end_time", 3.0}, {"distance", 1.0}}));
-  REQUIRE(names<fb::MobileRobotBlock>(give) == Names{"GIVE"});
+  REQUIRE(fb::event_names(give) == Names{"GIVE"});
   const auto again = f.send("TICK");
-  REQUIRE(names<fb::MobileRobotBlock>(again) == Names{"GIVE"});
+  REQUIRE(fb::event_names(again) == Names{"GIVE"});
   CHECK(again[0].data == give[0].data);  // the same command id: the buffer carries it out once
   // An answer to another robot's give is not an answer to this one.
   f.send("GIVE_EVENT", {{"command_id", std::string("f9/give")}, {"state", std::string("accepted")}, {"reason", std::string()}});
-  CHECK(names<fb::MobileRobotBlock>(f.send("TICK")) == Names{"GIVE"});
+  CHECK(fb::event_names(f.send("TICK")) == Names{"GIVE"});
   const std::string& id = fb::get<std::string>(give[0].data, "command_id");
   // Accepted is not the end: a buffer that ends now takes the answer with it.
   f.send("GIVE_EVENT", {{"command_id", id}, {"state", std::string("accepted")}, {"reason", std::string()}});
-  CHECK(names<fb::MobileRobotBlock>(f.send("TICK")) == Names{"GIVE"});
+  CHECK(fb::event_names(f.send("TICK")) == Names{"GIVE"});
   CHECK(f.block().state() == "WAIT_GIVE");
   const auto to_station =
       f.send("GIVE_EVENT", {{"command_id", id}, {"state", std::string("succeeded")}, {"reason", std::string()}});
-  REQUIRE(names<fb::MobileRobotBlock>(to_station) == Names{"SIM"});
+  REQUIRE(fb::event_names(to_station) == Names{"SIM"});
   CHECK(f.send("TICK").empty());
 }
 
@@ -208,9 +203,9 @@ TEST_CASE("buffer: a give whose answer died with the process is undone, or answe
     // out, and is killed before it answers.
     fb::BlockTestFixture<fb::BufferBlock> before("buffer", "buffer-1", seed);
     CHECK(before.block().keep_state_in(store).empty());
-    REQUIRE(names<fb::BufferBlock>(before.send("COMMAND", give)) == Names{"ACCEPT"});
+    REQUIRE(fb::event_names(before.send("COMMAND", give)) == Names{"ACCEPT"});
     store.command_taken({"buffer-1", "o1/g1", "o1", "give", "o1/peg"});
-    REQUIRE(names<fb::BufferBlock>(before.send("START", {{"command_id", std::string("o1/g1")}})) ==
+    REQUIRE(fb::event_names(before.send("START", {{"command_id", std::string("o1/g1")}})) ==
             Names{"DONE", "CAPABILITY"});
     CHECK(before.block().count("Peg") == 1);
   }
@@ -226,8 +221,8 @@ TEST_CASE("buffer: a give whose answer died with the process is undone, or answe
     store.command_ended("buffer-1", "o1/g1");
     CHECK_THAT(after.block().keep_state_in(store), !Catch::Contains("back in stock"));
     CHECK(after.block().count("Peg") == 1);
-    REQUIRE(names<fb::BufferBlock>(after.send("COMMAND", give)) == Names{"ACCEPT"});
-    REQUIRE(names<fb::BufferBlock>(after.send("START", {{"command_id", std::string("o1/g1")}})) == Names{"DONE"});
+    REQUIRE(fb::event_names(after.send("COMMAND", give)) == Names{"ACCEPT"});
+    REQUIRE(fb::event_names(after.send("START", {{"command_id", std::string("o1/g1")}})) == Names{"DONE"});
     CHECK(after.block().count("Peg") == 1);
     CHECK(store.inventory().at("Peg").in_transit == 1);
     CHECK(store.inventory().at("Peg").in_buffers == 1);
@@ -302,7 +297,7 @@ TEST_CASE("device: work queued for an order that has ended fails at once", "[fb]
                      {"part_type", std::string("Peg")}, {"source_award", std::string("o1/give/Peg")}});
   f.send("ORDER_ENDED", {{"order_id", std::string("o1")}});
   const auto started = f.send("START", {{"command_id", std::string("f1")}});
-  REQUIRE(names<fb::MobileRobotBlock>(started) == Names{"FAIL"});
+  REQUIRE(fb::event_names(started) == Names{"FAIL"});
   CHECK(fb::get<std::string>(started[0].data, "reason") == "order o1 has ended");
 }
 
@@ -397,7 +392,7 @@ TEST_CASE("device: only the order its contractor authorises commands it", "[fb][
   });
   CHECK(arm_refusal(f, "grip", with(kGrasp, "order_id", std::string("ok1"))).empty());
   const auto out = f.send("COMMAND", command("x1", "release", {{"order_id", std::string("intruder")}}));
-  REQUIRE(names<fb::ArmBlock>(out) == Names{"REFUSE"});
+  REQUIRE(fb::event_names(out) == Names{"REFUSE"});
   CHECK(fb::get<std::string>(out[0].data, "reason") == "arm-1 is reserved by ok1");
   CHECK(fb::get<std::string>(out[0].data, "order_id") == "intruder");
 }

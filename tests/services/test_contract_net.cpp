@@ -15,11 +15,6 @@
 namespace {
 
 using Names = std::vector<std::string>;
-template <class B>
-Names names(const std::vector<fb::Event>& events) {
-  return fb::BlockTestFixture<B>::names(events);
-}
-
 fb::Data cfp(const std::string& order, const std::string& operation, double duration = 10) {
   return {{"call_id", order + "/" + operation}, {"order_id", order},   {"operation", operation},
           {"part_type", std::string()},         {"station", std::string("station-1")},
@@ -42,12 +37,12 @@ TEST_CASE("contractor: bids only for what it offers, after the orders it holds a
                                          [] { return now; });
   CHECK(f.send("CFP", cfp("o1", "fetch")).empty());  // not an operation it offers
   const auto bid = f.send("CFP", cfp("o1", "host", 30));
-  REQUIRE(names<fb::Contractor>(bid) == Names{"PROPOSE"});
+  REQUIRE(fb::event_names(bid) == Names{"PROPOSE"});
   CHECK(fb::get<bool>(bid[0].data, "available"));
   CHECK(fb::get<double>(bid[0].data, "earliest_start") == 100);
   CHECK(fb::get<double>(bid[0].data, "duration") == 30);
   const auto held = f.send("AWARD", award("o1", "host"));
-  REQUIRE(names<fb::Contractor>(held) == Names{"REPLY", "RESERVED", "AWARDED"});
+  REQUIRE(fb::event_names(held) == Names{"REPLY", "RESERVED", "AWARDED"});
   CHECK(fb::get<bool>(held[0].data, "confirmed"));
   CHECK(fb::get<std::int64_t>(held[0].data, "ahead") == 0);
   CHECK(f.block().reserved_by() == "o1");
@@ -71,9 +66,9 @@ TEST_CASE("contractor: bids only for what it offers, after the orders it holds a
   CHECK(f.block().waiting() == Names{"o2", "o3"});
 
   // o2 gives up waiting (its twin ended); o1 releases: o3 holds it.
-  REQUIRE(names<fb::Contractor>(f.send("ORDER_ENDED", {{"order_id", std::string("o2")}})) == Names{"RESERVED"});
+  REQUIRE(fb::event_names(f.send("ORDER_ENDED", {{"order_id", std::string("o2")}})) == Names{"RESERVED"});
   const auto next = f.send("RELEASE", {{"order_id", std::string("o1")}, {"resource_id", std::string("station-1")}});
-  REQUIRE(names<fb::Contractor>(next) == Names{"RESERVED"});
+  REQUIRE(fb::event_names(next) == Names{"RESERVED"});
   CHECK(fb::get<std::string>(next[0].data, "order_id") == "o3");
   CHECK(f.block().waiting().empty());
   CHECK(f.block().refusal("o3", "o3/host").empty());
@@ -96,7 +91,7 @@ TEST_CASE("contractor: a shared resource takes work into its queue and bids afte
                                          [] { return now; });
   f.send("CFP", cfp("o1", "fetch", 8));
   const auto taken = f.send("AWARD", award("o1", "fetch", "robot-1"));
-  REQUIRE(names<fb::Contractor>(taken) == Names{"REPLY", "AWARDED"});
+  REQUIRE(fb::event_names(taken) == Names{"REPLY", "AWARDED"});
   CHECK(fb::get<std::string>(taken[1].data, "order_id") == "o1");
   CHECK(f.block().reserved_by().empty());
   CHECK(f.block().refusal("o1", "o1/fetch").empty());
@@ -155,19 +150,19 @@ TEST_CASE("negotiator: once every capable resource answered, the earliest finish
   f.send("CAPABILITY", capability("robot-2", "fetch"));
   f.send("CAPABILITY", capability("buffer-1", "give"));
   const auto out = f.send("CALL", cfp("o1", "fetch"));
-  REQUIRE(names<fb::Negotiator>(out) == Names{"CFP"});
+  REQUIRE(fb::event_names(out) == Names{"CFP"});
   CHECK(fb::get<std::string>(out[0].data, "order_id") == "o1");
   // robot-1 starts sooner but finishes later.
   CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 10, 30)).empty());
   const auto award = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 20, 5));
-  REQUIRE(names<fb::Negotiator>(award) == Names{"AWARD"});
+  REQUIRE(fb::event_names(award) == Names{"AWARD"});
   CHECK(fb::get<std::string>(award[0].data, "resource_id") == "robot-2");
   // robot-2 refuses: the next best is awarded; it confirms.
   const auto next = f.send("AWARD_REPLY", reply("o1/fetch", "robot-2", false));
-  REQUIRE(names<fb::Negotiator>(next) == Names{"AWARD"});
+  REQUIRE(fb::event_names(next) == Names{"AWARD"});
   CHECK(fb::get<std::string>(next[0].data, "resource_id") == "robot-1");
   const auto done = f.send("AWARD_REPLY", reply("o1/fetch", "robot-1", true, 2));
-  REQUIRE(names<fb::Negotiator>(done) == Names{"AWARDED"});
+  REQUIRE(fb::event_names(done) == Names{"AWARDED"});
   CHECK(fb::get<std::string>(done[0].data, "resource_id") == "robot-1");
   CHECK(fb::get<std::int64_t>(done[0].data, "ahead") == 2);
   CHECK(f.block().open_calls() == 0);
@@ -181,10 +176,10 @@ TEST_CASE("negotiator: a call for quotes reports the best bid and awards nothing
   f.send("CAPABILITY", capability("robot-1", "fetch"));
   f.send("CAPABILITY", capability("robot-2", "fetch"));
   f.send("CAPABILITY", capability("buffer-1", "give"));
-  REQUIRE(names<fb::Negotiator>(f.send("ASK", cfp("o1", "fetch"))) == Names{"CFP"});
+  REQUIRE(fb::event_names(f.send("ASK", cfp("o1", "fetch"))) == Names{"CFP"});
   CHECK(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 10, 30)).empty());
   const auto quoted = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 20, 5, 12));
-  REQUIRE(names<fb::Negotiator>(quoted) == Names{"QUOTED"});
+  REQUIRE(fb::event_names(quoted) == Names{"QUOTED"});
   CHECK(fb::get<std::string>(quoted[0].data, "resource_id") == "robot-2");
   CHECK(fb::get<double>(quoted[0].data, "earliest_start") == 20);
   CHECK(fb::get<double>(quoted[0].data, "duration") == 5);
@@ -200,7 +195,7 @@ TEST_CASE("negotiator: a call for quotes reports the best bid and awards nothing
                             {"earliest_start", 0.0}, {"duration", 0.0}}).empty());
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
   const auto out = f.send("TICK");
-  REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
+  REQUIRE(fb::event_names(out) == Names{"UNAVAILABLE"});
   CHECK(fb::get<std::string>(out[0].data, "reason") == "nobody offered give (buffer-1: buffer-1 has no Shaft)");
   CHECK(f.block().open_calls() == 0);
 }
@@ -227,10 +222,10 @@ TEST_CASE("negotiator: a call nobody bids on is called again, then unavailable w
   CHECK(f.send("PROPOSAL", {{"call_id", std::string("o1/give")}, {"resource_id", std::string("buffer-1")},
                             {"available", false}, {"reason", std::string("buffer-1 has 0 Shaft free, not 1")},
                             {"earliest_start", 0.0}, {"duration", 0.0}}).empty());
-  CHECK(names<fb::Negotiator>(f.send("TICK")) == Names{"CFP"});  // called again
+  CHECK(fb::event_names(f.send("TICK")) == Names{"CFP"});  // called again
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
   const auto out = f.send("TICK");
-  REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
+  REQUIRE(fb::event_names(out) == Names{"UNAVAILABLE"});
   const std::string& reason = fb::get<std::string>(out[0].data, "reason");
   CHECK(reason.find("buffer-1: buffer-1 has 0 Shaft free, not 1") != std::string::npos);
   // A live resource that offers the operation and never answered is named: its answers do
@@ -258,7 +253,7 @@ TEST_CASE("negotiator: a resource of the cell's roster it never heard, or heard 
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
   const auto out = f.send("TICK");
-  REQUIRE(names<fb::Negotiator>(out) == Names{"UNAVAILABLE"});
+  REQUIRE(fb::event_names(out) == Names{"UNAVAILABLE"});
   const std::string& reason = fb::get<std::string>(out[0].data, "reason");
   INFO(reason);
   CHECK(reason.find("rack-a: 0 free, not 5; rack-b: 0 free, not 5") != std::string::npos);
@@ -282,27 +277,27 @@ TEST_CASE("negotiator: a confirmation that comes after the reply timeout is take
                                               [] { return now; });
   twin.send("CAPABILITY", capability("buffer-2", "give"));
   const auto first = twin.send("CALL", cfp("o1", "give", 0));
-  REQUIRE(names<fb::Negotiator>(first) == Names{"CFP"});
+  REQUIRE(fb::event_names(first) == Names{"CFP"});
   buffer.send("CFP", first[0].data);
-  REQUIRE(names<fb::Negotiator>(twin.send("PROPOSAL", proposal("o1/give", "buffer-2", 0, 1))) == Names{"AWARD"});
+  REQUIRE(fb::event_names(twin.send("PROPOSAL", proposal("o1/give", "buffer-2", 0, 1))) == Names{"AWARD"});
   const auto taken = buffer.send("AWARD", award("o1", "give", "buffer-2"));
-  REQUIRE(names<fb::Contractor>(taken) == Names{"REPLY", "AWARDED"});
+  REQUIRE(fb::event_names(taken) == Names{"REPLY", "AWARDED"});
 
   std::this_thread::sleep_for(std::chrono::milliseconds(2));
   CHECK(twin.send("TICK").empty());                                  // given up on
-  CHECK(names<fb::Negotiator>(twin.send("TICK")) == Names{"CFP"});  // and called again
+  CHECK(fb::event_names(twin.send("TICK")) == Names{"CFP"});  // and called again
   const auto again = buffer.send("CFP", cfp("o1", "give", 0));
-  REQUIRE(names<fb::Contractor>(again) == Names{"PROPOSE"});
+  REQUIRE(fb::event_names(again) == Names{"PROPOSE"});
   // Awarded a second time for the same call: confirmed, nothing taken twice.
   const auto twice = buffer.send("AWARD", award("o1", "give", "buffer-2"));
-  REQUIRE(names<fb::Contractor>(twice) == Names{"REPLY"});
+  REQUIRE(fb::event_names(twice) == Names{"REPLY"});
   CHECK(fb::get<bool>(twice[0].data, "confirmed"));
 
   // The first confirmation, late, settles the call.
   fb::Data late = taken[0].data;
   late["resource_id"] = std::string("buffer-2");
   const auto awarded = twin.send("AWARD_REPLY", late);
-  REQUIRE(names<fb::Negotiator>(awarded) == Names{"AWARDED"});
+  REQUIRE(fb::event_names(awarded) == Names{"AWARDED"});
   CHECK(fb::get<std::string>(awarded[0].data, "resource_id") == "buffer-2");
   CHECK(twin.block().open_calls() == 0);
 }
@@ -316,7 +311,7 @@ TEST_CASE("negotiator: the awarded resource disappears before it confirms: the n
   const auto award = f.send("PROPOSAL", proposal("o1/host", "station-2", 5, 10));
   CHECK(fb::get<std::string>(award[0].data, "resource_id") == "station-1");
   const auto next = f.send("RESOURCE_GONE", {{"resource_id", std::string("station-1")}});
-  REQUIRE(names<fb::Negotiator>(next) == Names{"AWARD"});
+  REQUIRE(fb::event_names(next) == Names{"AWARD"});
   CHECK(fb::get<std::string>(next[0].data, "resource_id") == "station-2");
 }
 
@@ -325,7 +320,7 @@ TEST_CASE("contract net: calls and bids that are not numbers are refused with a 
                                                   holds(), [] { return 0.0; });
   for (double bad : {std::nan(""), -1.0, std::numeric_limits<double>::infinity()}) {
     const auto refusal = contractor.send("CFP", cfp("o1", "host", bad));
-    REQUIRE(names<fb::Contractor>(refusal) == Names{"PROPOSE"});
+    REQUIRE(fb::event_names(refusal) == Names{"PROPOSE"});
     CHECK_FALSE(fb::get<bool>(refusal[0].data, "available"));
     CHECK(fb::get<std::string>(refusal[0].data, "reason") == "the call's duration is not a number >= 0");
   }
@@ -336,7 +331,7 @@ TEST_CASE("contract net: calls and bids that are not numbers are refused with a 
   f.send("CALL", cfp("o1", "host"));
   CHECK(f.send("PROPOSAL", proposal("o1/host", "station-1", std::nan(""), 1)).empty());
   const auto award = f.send("PROPOSAL", proposal("o1/host", "station-2", 50, 10));
-  REQUIRE(names<fb::Negotiator>(award) == Names{"AWARD"});
+  REQUIRE(fb::event_names(award) == Names{"AWARD"});
   CHECK(fb::get<std::string>(award[0].data, "resource_id") == "station-2");
 }
 
@@ -388,12 +383,12 @@ TEST_CASE("negotiator: a resource of the cell's roster not heard yet, of a kind 
   f.send("ROSTER", {{"resources", std::string("robot-1\tmobile-robot\nrobot-2\tmobile-robot\nstation-1\tstation\n")}});
   f.send("CAPABILITY", {{"resource_id", std::string("robot-1")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
   f.send("CALL", cfp("o1", "fetch"));
-  CHECK(names<fb::Negotiator>(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9))).empty());
-  CHECK(names<fb::Negotiator>(f.send("TICK")).empty());  // within the window
+  CHECK(fb::event_names(f.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9))).empty());
+  CHECK(fb::event_names(f.send("TICK")).empty());  // within the window
   // robot-2 comes and bids better: the call is all answered, and it wins.
   f.send("CAPABILITY", {{"resource_id", std::string("robot-2")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
   const auto out = f.send("PROPOSAL", proposal("o1/fetch", "robot-2", 0, 5));
-  REQUIRE(names<fb::Negotiator>(out) == Names{"AWARD"});
+  REQUIRE(fb::event_names(out) == Names{"AWARD"});
   CHECK(fb::get<std::string>(out[0].data, "resource_id") == "robot-2");
 
   // One that never comes holds a call up for the window only.
@@ -402,9 +397,9 @@ TEST_CASE("negotiator: a resource of the cell's roster not heard yet, of a kind 
   g.send("ROSTER", {{"resources", std::string("robot-1\tmobile-robot\nrobot-3\tmobile-robot\n")}});
   g.send("CAPABILITY", {{"resource_id", std::string("robot-1")}, {"kind", std::string("mobile-robot")}, {"operations", std::string("fetch")}});
   g.send("CALL", cfp("o1", "fetch"));
-  CHECK(names<fb::Negotiator>(g.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9))).empty());
+  CHECK(fb::event_names(g.send("PROPOSAL", proposal("o1/fetch", "robot-1", 0, 9))).empty());
   std::this_thread::sleep_for(std::chrono::milliseconds(60));
   const auto later = g.send("TICK");
-  REQUIRE(names<fb::Negotiator>(later) == Names{"AWARD"});
+  REQUIRE(fb::event_names(later) == Names{"AWARD"});
   CHECK(fb::get<std::string>(later[0].data, "resource_id") == "robot-1");
 }

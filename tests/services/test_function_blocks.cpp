@@ -44,11 +44,6 @@ class Worker : public fb::BasicChart<Job> {
 };
 
 using Names = std::vector<std::string>;
-template <class B>
-Names names(const std::vector<fb::Event>& events) {
-  return fb::BlockTestFixture<B>::names(events);
-}
-
 }  // namespace
 
 TEST_CASE("a resource delivers events along its connections, one at a time, in order", "[fb]") {
@@ -105,7 +100,7 @@ TEST_CASE("wiring mistakes are errors at once", "[fb]") {
 
 TEST_CASE("an ECC fires the first transition whose event and guard match", "[fb]") {
   fb::BlockTestFixture<Counter> fixture("counter");
-  CHECK(names<Counter>(fixture.send("REQ", {{"step", std::int64_t{5}}})) == Names{"CNF"});
+  CHECK(fb::event_names(fixture.send("REQ", {{"step", std::int64_t{5}}})) == Names{"CNF"});
   CHECK(fixture.block().count == 5);
   CHECK(fixture.send("REQ", {{"step", std::int64_t{-1}}}).empty());  // guard false: consumed
   CHECK(fixture.block().unhandled_events() == 1);
@@ -117,12 +112,12 @@ TEST_CASE("an ECC fires the first transition whose event and guard match", "[fb]
 TEST_CASE("command life cycle: accepted, executing, succeeded", "[fb][lifecycle]") {
   fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
   const auto accepted = f.send("COMMAND", {{"command_id", std::string("c1")}});
-  CHECK(names<fb::CommandLifecycle>(accepted) == Names{"ACCEPTED", "START"});
+  CHECK(fb::event_names(accepted) == Names{"ACCEPTED", "START"});
   CHECK(fb::get<std::string>(accepted[0].data, "command_id") == "c1");
   const auto progress = f.send("PROGRESS", {{"progress", 0.5}});
-  REQUIRE(names<fb::CommandLifecycle>(progress) == Names{"EXECUTING"});
+  REQUIRE(fb::event_names(progress) == Names{"EXECUTING"});
   CHECK(fb::get<double>(progress[0].data, "progress") == 0.5);
-  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
+  CHECK(fb::event_names(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
 }
 
@@ -130,13 +125,13 @@ TEST_CASE("command life cycle: one command at a time, and failures carry their r
   fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
   f.send("COMMAND", {{"command_id", std::string("c1")}});
   const auto busy = f.send("COMMAND", {{"command_id", std::string("c2")}});
-  REQUIRE(names<fb::CommandLifecycle>(busy) == Names{"REJECTED"});
+  REQUIRE(fb::event_names(busy) == Names{"REJECTED"});
   CHECK(fb::get<std::string>(busy[0].data, "command_id") == "c2");
   CHECK(fb::get<std::string>(busy[0].data, "reason") == "busy with c1");
   const auto aborted = f.send("FAIL", {{"reason", std::string("collision with B6")}});
-  REQUIRE(names<fb::CommandLifecycle>(aborted) == Names{"ABORTED", "IDLE"});
+  REQUIRE(fb::event_names(aborted) == Names{"ABORTED", "IDLE"});
   CHECK(fb::get<std::string>(aborted[0].data, "reason") == "collision with B6");
-  CHECK(names<fb::CommandLifecycle>(f.send("COMMAND", {{"command_id", std::string("c2")}})) ==
+  CHECK(fb::event_names(f.send("COMMAND", {{"command_id", std::string("c2")}})) ==
         Names{"ACCEPTED", "START"});
 }
 
@@ -144,13 +139,13 @@ TEST_CASE("command life cycle: cancel, and a device that finishes before it can 
   fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle");
   f.send("COMMAND", {{"command_id", std::string("c1")}});
   CHECK(f.send("CANCEL", {{"command_id", std::string("other")}}).empty());  // not ours: ignored
-  CHECK(names<fb::CommandLifecycle>(f.send("CANCEL", {{"command_id", std::string("c1")}})) ==
+  CHECK(fb::event_names(f.send("CANCEL", {{"command_id", std::string("c1")}})) ==
         Names{"CANCELING", "STOP"});
-  CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
+  CHECK(fb::event_names(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
 
   f.send("COMMAND", {{"command_id", std::string("c2")}});
   f.send("CANCEL", {{"command_id", std::string("c2")}});
-  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
+  CHECK(fb::event_names(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
 }
 
@@ -170,18 +165,18 @@ TEST_CASE("events posted from another thread arrive in order", "[fb][threads]") 
 TEST_CASE("command life cycle with a queue: one executes, the rest wait their turn in order", "[fb][lifecycle]") {
   fb::BlockTestFixture<fb::CommandLifecycle> f("lifecycle", fb::CommandLifecycle::WhenBusy::queue);
   f.send("COMMAND", {{"command_id", std::string("c1")}});
-  CHECK(names<fb::CommandLifecycle>(f.send("COMMAND", {{"command_id", std::string("c2")}})) == Names{"ACCEPTED"});
+  CHECK(fb::event_names(f.send("COMMAND", {{"command_id", std::string("c2")}})) == Names{"ACCEPTED"});
   f.send("COMMAND", {{"command_id", std::string("c3")}});
   CHECK(f.block().queued() == 2);
   const auto done = f.send("DONE", {{"distance", 1.5}});
-  REQUIRE(names<fb::CommandLifecycle>(done) == Names{"SUCCEEDED", "EXECUTING", "START"});
+  REQUIRE(fb::event_names(done) == Names{"SUCCEEDED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(done[0].data, "command_id") == "c1");
   CHECK(fb::get<double>(done[0].data, "distance") == 1.5);  // the device's data goes along
   CHECK(fb::get<std::string>(done[1].data, "command_id") == "c2");
   const auto failed = f.send("FAIL", {{"reason", std::string("buffer-1 has no Peg")}});
-  REQUIRE(names<fb::CommandLifecycle>(failed) == Names{"ABORTED", "EXECUTING", "START"});
+  REQUIRE(fb::event_names(failed) == Names{"ABORTED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(failed[1].data, "command_id") == "c3");
-  CHECK(names<fb::CommandLifecycle>(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
+  CHECK(fb::event_names(f.send("DONE")) == Names{"SUCCEEDED", "IDLE"});
   CHECK(f.block().state() == "IDLE");
 }
 
@@ -191,10 +186,10 @@ TEST_CASE("command life cycle with a queue: a queued command is canceled at once
   f.send("COMMAND", {{"command_id", std::string("c2")}});
   f.send("COMMAND", {{"command_id", std::string("c3")}});
   const auto canceled = f.send("CANCEL", {{"command_id", std::string("c2")}});
-  REQUIRE(names<fb::CommandLifecycle>(canceled) == Names{"CANCELED"});
+  REQUIRE(fb::event_names(canceled) == Names{"CANCELED"});
   CHECK(fb::get<std::string>(canceled[0].data, "command_id") == "c2");
   const auto next = f.send("DONE");
-  REQUIRE(names<fb::CommandLifecycle>(next) == Names{"SUCCEEDED", "EXECUTING", "START"});
+  REQUIRE(fb::event_names(next) == Names{"SUCCEEDED", "EXECUTING", "START"});
   CHECK(fb::get<std::string>(next[1].data, "command_id") == "c3");  // c2 is gone
 }
 
@@ -204,7 +199,7 @@ TEST_CASE("command life cycle: a cancel counts only from the command's own order
     f.send("COMMAND", {{"command_id", std::string(id)}, {"order_id", std::string(order)}});
   };
   const auto cancel = [&](const char* id, const char* order) {
-    return names<fb::CommandLifecycle>(f.send("CANCEL", {{"command_id", std::string(id)}, {"order_id", std::string(order)}}));
+    return fb::event_names(f.send("CANCEL", {{"command_id", std::string(id)}, {"order_id", std::string(order)}}));
   };
   command("c1", "o1");
   command("c2", "o1");
@@ -214,14 +209,14 @@ TEST_CASE("command life cycle: a cancel counts only from the command's own order
   CHECK(f.block().queued() == 1);
   CHECK(cancel("c2", "o1") == Names{"CANCELED"});
   CHECK(cancel("c1", "o1") == Names{"CANCELING", "STOP"});
-  CHECK(names<fb::CommandLifecycle>(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
+  CHECK(fb::event_names(f.send("STOPPED")) == Names{"CANCELED", "IDLE"});
   CHECK(cancel("c1", "o1").empty());  // ended: nothing to cancel
 }
 
 TEST_CASE("a chart's internal event is taken by a transition once the action that raised it is over", "[fb]") {
   fb::BlockTestFixture<Worker> f("worker");
   const auto out = f.send("GO");
-  CHECK(names<Worker>(out) == Names{"STARTED", "FINISHED"});
+  CHECK(fb::event_names(out) == Names{"STARTED", "FINISHED"});
   CHECK(f.block().seen_in_action == Job::working);
   CHECK(f.block().state() == Job::done);
   CHECK(f.block().unhandled_events() == 0);

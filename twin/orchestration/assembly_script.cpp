@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "services/node/gripper.hpp"
+#include "twin/orchestration/booking.hpp"
 #include "twin/planning/subassembly_planner.hpp"
 
 namespace twin {
@@ -15,7 +16,6 @@ using fb::Data;
 using fb::get;
 using fb::Numbers;
 
-const std::string kGive = "give/";
 
 Pose with_translation(Pose pose, double x, double y, double z) {
   pose.translation() = Vec3(x, y, z);
@@ -227,7 +227,7 @@ PhysicalScript physical_script(const LoadedProduct& product, const Plan& plan, c
     fetch["part_type"] = type;
     fetch["source"] = buffer;
     fetch["destination"] = hired.station;
-    fetch["source_award"] = hired.order + "/" + kGive + type;
+    fetch["source_award"] = Booking::give_call_id(hired.order, type);
     script.fetch_of[get<std::string>(fetch, "command_id")] = step.part;
     fetches.push_back(get<std::string>(fetch, "command_id"));
     actions.push_back({ScriptAction::send_heard, fetch});

@@ -18,6 +18,8 @@ Data Booking::call(const std::string& what, const std::string& operation, const 
           {"station", station}, {"sources", sources}, {"count", std::int64_t(count)}, {"duration", duration}};
 }
 
+std::string Booking::give_call_id(const std::string& order, const std::string& type) { return order + "/" + kGive + type; }
+
 Data Booking::host(const std::string& only, double hold) const { return call(kHost, kHost, "", 0, hold, only); }
 
 Data Booking::arm(double hold) const { return call(kArm, "translate", "", 0, hold, station_); }

@@ -41,6 +41,8 @@ class Booking {
   void leave_station();
   // How long the bidder's queue holds the work up, from a QUOTED (its own clock).
   static double queue_of(const fb::Data& quoted);
+  // The id of the order's call for a buffer of `type`: a fetch names the award it draws on.
+  static std::string give_call_id(const std::string& order, const std::string& type);
 
   const std::string& station() const { return station_; }
   const std::string& arm_resource() const { return arm_; }

@@ -9,9 +9,8 @@
 namespace twin {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kClearance = 0.010;         // m between the part and the mate's thread before it turns
-constexpr double kStep = kPi / 18;           // rad between the helix's waypoints: 10 degrees
+constexpr double kStep = EIGEN_PI / 18;           // rad between the helix's waypoints: 10 degrees
 constexpr double kWaypointsAtMost = 1800;    // 50 turns; a longer thread is not planned
 
 // The pose turned by `angle` about the line through `point` along `axis`.
@@ -51,7 +50,7 @@ std::vector<Trajectory> screw_insertions(const AssemblyScene& scene, PartIndex p
   for (const double sense : {1.0, -1.0}) {
     const Vec3 direction = thread.axis * sense;
     const double travel = std::max(clear_after(product, part, thread, -direction), thread.length) + thread.pitch;
-    const double angle = 2 * kPi * travel / thread.pitch;
+    const double angle = 2 * EIGEN_PI * travel / thread.pitch;
     if (angle / kStep > kWaypointsAtMost) continue;
     // Where the helix begins: backed off along the axis and turned back.
     const auto on_helix = [&](double u) {  // u: 0 at the start, 1 in place

@@ -11,7 +11,6 @@
 namespace twin {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kFewestPoints = 12;  // an overlap sampled by fewer says nothing of its shape
 constexpr int kSectors = 12;               // "all round": the overlap in at least 11 of 12 sectors
 // m: the samples lie up to the overlap's depth from either surface; the shell they make is
@@ -53,7 +52,7 @@ Fit fit_about(const std::vector<Vec3>& points, const Line& line) {
     fit.outer = std::max(fit.outer, r);
     fit.low = std::min(fit.low, along);
     fit.high = std::max(fit.high, along);
-    const int sector = static_cast<int>(std::floor((std::atan2(y, x) + kPi) / (2 * kPi) * kSectors));
+    const int sector = static_cast<int>(std::floor((std::atan2(y, x) + EIGEN_PI) / (2 * EIGEN_PI) * kSectors));
     hit[static_cast<std::size_t>(std::clamp(sector, 0, kSectors - 1))] = true;
   }
   fit.sectors = static_cast<int>(std::count(hit.begin(), hit.end(), true));
@@ -138,7 +137,7 @@ bool ridged(const std::vector<Vec3>& vertices, const Fit& fit, double pitch) {
     if (r < low || r > high) continue;
     least = std::min(least, r);
     most = std::max(most, r);
-    const int sector = static_cast<int>(std::floor((std::atan2(y, x) + kPi) / (2 * kPi) * kSectors));
+    const int sector = static_cast<int>(std::floor((std::atan2(y, x) + EIGEN_PI) / (2 * EIGEN_PI) * kSectors));
     double& c = crest[static_cast<std::size_t>(std::clamp(sector, 0, kSectors - 1))];
     c = std::max(c, r);
   }
