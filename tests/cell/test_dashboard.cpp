@@ -169,7 +169,7 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
 }
 
 TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes an order of the cell's, and the operator "
-          "cancels one; a stranger's, another site's, a hostile or a bad one is refused with the reason, and nothing is kept",
+          "cancels one, while a stranger's, another site's, a hostile or a bad one is refused with the reason, and nothing is kept",
           "[process][cell][dashboard]") {
   using namespace std::chrono_literals;
   namespace fs = std::filesystem;

@@ -180,7 +180,7 @@ TEST_CASE("an order's plan is stored whole and replaced whole, and kept across a
   CHECK(again.plan_of("o2") == std::vector<state::PlanStepRecord>{{"b1", "down"}});
 }
 
-TEST_CASE("a cancel is asked of an order that has not ended, and says who asked; an older database gets the column",
+TEST_CASE("a cancel is asked of an order that has not ended, and says who asked, and an older database gets the column",
           "[state]") {
   const auto dir = fresh_dir("cancel");
   {
