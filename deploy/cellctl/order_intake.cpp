@@ -45,7 +45,6 @@ std::string description_error(const fs::path& aml, const fs::path& folder) {
   }
 }
 
-
 UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::string_view zip, std::string order,
                          const std::string& who) {
   if (order.empty()) order = "upload-" + random_hex(4);

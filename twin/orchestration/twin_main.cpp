@@ -439,9 +439,13 @@ class TwinProcess {
       // Whether the operator cancelled the order (cellctl cancel, the dashboard): once a second.
       if (store_ && !cancelled && now - last_look > std::chrono::seconds(1)) {
         last_look = now;
-        if (const std::string who = store_->cancel_requested(options_.order); !who.empty()) {
-          cancelled = true;
-          r.post("orchestrator", "STOP", {{"reason", "cancelled by " + who}});
+        try {
+          if (const std::string who = store_->cancel_requested(options_.order); !who.empty()) {
+            cancelled = true;
+            r.post("orchestrator", "STOP", {{"reason", "cancelled by " + who}});
+          }
+        } catch (const state::StoreError& e) {  // the database busy past its retries: asked again in a second
+          std::cerr << "order " << options_.order << ": " << e.what() << '\n';
         }
       }
     }
