@@ -4,18 +4,20 @@
 # the block, DDS and process tests (labels blocks, dds, processes) once more under
 # ThreadSanitizer; then each libFuzzer target for 30 s (deploy/fuzz.sh; longer runs,
 # optimised, by hand). The sanitizer trees are built with clang: it compiles them faster
-# than GCC, and the libFuzzer targets are built in the ASan tree, one build less. They are
-# unity builds (CMake joins up to 8 sources of a library or program into one: the large
-# headers are read once, not 8 times; the tests' sources stay apart); the Release tree is
-# not, so that every source is still compiled on its own.
+# than GCC, and the libFuzzer targets are built in the ASan tree, one build less. All three
+# are unity builds (CMake joins up to 8 sources of a library or program into one: the large
+# headers are read once, not 8 times; the tests' sources stay apart). A build by hand
+# (README) compiles every source on its own.
 # docs/performance.md has the time of each phase.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh --tests
 
 jobs=$(nproc)
+unity=(-DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=8)
 # Benchmarks are built where they are run (docs/performance.md), not in this job's time.
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELL_BUILD_TESTS=ON -DCELL_BUILD_BENCHMARKS=OFF
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELL_BUILD_TESTS=ON -DCELL_BUILD_BENCHMARKS=OFF \
+  "${unity[@]}"
 cmake --build build/release -j "$jobs"
 # Shared-memory segments of DDS processes that died hard break discovery: clean them first.
 fastdds shm clean >/dev/null 2>&1 || true
@@ -23,7 +25,6 @@ fastdds shm clean >/dev/null 2>&1 || true
 # suite must hold with 4 at once on 2 cores anyway.
 ctest --test-dir build/release --output-on-failure -j "$((2 * jobs))"
 
-unity=(-DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=8)
 cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_SANITIZE=ON -DCELL_FUZZ=ON \
   -DCMAKE_CXX_COMPILER=clang++ -DCELL_BUILD_BENCHMARKS=OFF "${unity[@]}"
 cmake --build build/sanitize -j "$jobs"
