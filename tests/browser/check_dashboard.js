@@ -165,7 +165,6 @@ function percentile(values, p) {
       if (!alarms.some((a) => a.includes(buffer) && a.includes("restarted"))) problems.push("no alarm says " + buffer + " restarted");
     }
     // The operator cancels an order from its row (the page asks first): it fails with the reason.
-    page.on("dialog", (d) => d.accept());
     const again = await upload(productZip, "dash-c");
     if (again.cls !== "answer-ok") problems.push("the product's zip was not taken again: " + JSON.stringify(again));
     const cancel = await page.waitForFunction(() => {
@@ -175,8 +174,11 @@ function percentile(values, p) {
     if (!cancel) {
       problems.push("dash-c has no cancel button");
     } else {
+      // The page's script stands still while its question is open: the wait begins once it is answered.
+      const asked = new Promise((resolve) => page.once("dialog", (d) => d.accept().then(resolve, resolve)));
       await cancel.asElement().click();
-      await shows("dash-c", "FAILED").catch(() => problems.push("dash-c, cancelled, never showed FAILED"));
+      await asked;
+      await shows("dash-c", "FAILED").catch((e) => problems.push("dash-c, cancelled, never showed FAILED: " + e.message));
       const reason = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-c")
         .map((tr) => tr.cells[5].textContent).join(""));
       if (!reason.startsWith("cancelled by the operator (dashboard)")) problems.push("dash-c failed for another reason: " + reason);
