@@ -21,8 +21,8 @@ cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DCELL_BUILD_TES
 cmake --build build/release -j "$jobs"
 # Shared-memory segments of DDS processes that died hard break discovery: clean them first.
 fastdds shm clean >/dev/null 2>&1 || true
-# Twice as many tests as cores: most of a process test's time is waiting on the cell, and the
-# suite must hold with 4 at once on 2 cores anyway.
+# Twice as many tests as cores: the suite must hold with 4 at once on 2 cores. (It keeps both
+# cores busy either way: more at once would not make the phase shorter, docs/performance.md.)
 ctest --test-dir build/release --output-on-failure -j "$((2 * jobs))"
 
 cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCELL_SANITIZE=ON -DCELL_FUZZ=ON \
