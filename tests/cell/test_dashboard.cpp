@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <memory>
 #include <regex>
 #include <string>
 #include <thread>
@@ -54,6 +55,31 @@ class RawConnection {
   bool connected_ = false;
 };
 
+// `cellctl up --dashboard` on the default cell of a domain of the test's own, and the address
+// it printed: the port and the token.
+struct DashboardCell {
+  std::unique_ptr<test::ChildProcess> up;
+  int port = 0;
+  std::string token;
+};
+
+DashboardCell start_dashboard_cell(const std::filesystem::path& dir, const std::string& domain) {
+  using namespace std::chrono_literals;
+  test::clean_stale_dds_segments();
+  DashboardCell cell;
+  cell.up = std::make_unique<test::ChildProcess>(
+      std::vector<std::string>{CELLCTL_EXE, "up", DEFAULT_CELL, "--domain", domain, "--state-dir", (dir / "state").string(),
+                               "--dashboard", "127.0.0.1:0"},
+      (dir / "up.log").string());
+  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 90s));
+  std::smatch m;
+  const std::string log = test::read_text(dir / "up.log");
+  REQUIRE(std::regex_search(log, m, std::regex("dashboard: http://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
+  cell.port = std::stoi(m[1]);
+  cell.token = m[2];
+  return cell;
+}
+
 }  // namespace
 
 TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, and stalled connections do not stop it",
@@ -61,16 +87,9 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
   using namespace std::chrono_literals;
   const auto dir = test::scratch("dashboard");
   const std::string domain = "175";
-  test::clean_stale_dds_segments();
-  test::ChildProcess up({CELLCTL_EXE, "up", DEFAULT_CELL, "--domain", domain, "--state-dir", (dir / "state").string(),
-                         "--dashboard", "127.0.0.1:0"},
-                        (dir / "up.log").string());
-  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 90s));
-  std::smatch m;
-  const std::string log = test::read_text(dir / "up.log");
-  REQUIRE(std::regex_search(log, m, std::regex("dashboard: http://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
-  const int port = std::stoi(m[1]);
-  const std::string token = m[2];
+  const DashboardCell cell = start_dashboard_cell(dir, domain);
+  const int port = cell.port;
+  const std::string& token = cell.token;
   CHECK(test::read_text(dir / "state" / "dashboard.token") == token + "\n");
   CHECK((std::filesystem::status(dir / "state" / "dashboard.token").permissions() & std::filesystem::perms::others_read) ==
         std::filesystem::perms::none);
@@ -165,7 +184,7 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
   }
 
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
-  CHECK(up.wait_for_exit(20s) == 0);
+  CHECK(cell.up->wait_for_exit(20s) == 0);
 }
 
 TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes an order of the cell's, and the operator "
@@ -175,16 +194,9 @@ TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes a
   namespace fs = std::filesystem;
   const auto dir = test::scratch("dashboard-orders");
   const std::string domain = "173";
-  test::clean_stale_dds_segments();
-  test::ChildProcess up({CELLCTL_EXE, "up", DEFAULT_CELL, "--domain", domain, "--state-dir", (dir / "state").string(),
-                         "--dashboard", "127.0.0.1:0"},
-                        (dir / "up.log").string());
-  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 90s));
-  std::smatch m;
-  const std::string log = test::read_text(dir / "up.log");
-  REQUIRE(std::regex_search(log, m, std::regex("dashboard: http://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
-  const int port = std::stoi(m[1]);
-  const httplib::Headers bearer{{"Authorization", "Bearer " + std::string(m[2])}};
+  const DashboardCell cell = start_dashboard_cell(dir, domain);
+  const int port = cell.port;
+  const httplib::Headers bearer{{"Authorization", "Bearer " + cell.token}};
   httplib::Client client("127.0.0.1", port);
   client.set_read_timeout(30, 0);
   const std::string zip = test::read_text(LEGO_ZIP);
@@ -280,5 +292,5 @@ TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes a
   REQUIRE(r);
   CHECK(r->status == 409);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
-  CHECK(up.wait_for_exit(20s) == 0);
+  CHECK(cell.up->wait_for_exit(20s) == 0);
 }

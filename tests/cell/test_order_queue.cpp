@@ -30,6 +30,15 @@ bool journaled(const fs::path& state, const std::string& event, const std::strin
   return false;
 }
 
+// The default cell with at most `max_twins` orders under way, written into `dir`.
+fs::path cell_with_max_twins(const fs::path& dir, int max_twins) {
+  std::string yaml = test::read_text(DEFAULT_CELL);
+  yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: " + std::to_string(max_twins));
+  const fs::path cell = dir / "cell.yaml";
+  std::ofstream(cell) << yaml;
+  return cell;
+}
+
 }  // namespace
 
 TEST_CASE("order queue: past max_twins orders wait in the order they came and say their places, and a killed up loses none",
@@ -37,10 +46,7 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("order-queue"), state = dir / "state";
   const std::string domain = "231";
-  std::string yaml = test::read_text(DEFAULT_CELL);
-  yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: 2");
-  const fs::path cell = dir / "cell.yaml";
-  std::ofstream(cell) << yaml;
+  const fs::path cell = cell_with_max_twins(dir, 2);
   const auto up_argv = [&] {
     return std::vector<std::string>{CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
                                     "--state-dir", state.string()};
@@ -140,10 +146,7 @@ TEST_CASE("cancel: a queued order never starts, one in physical assembly fails w
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("cancel"), state = dir / "state";
   const std::string domain = "172";
-  std::string yaml = test::read_text(DEFAULT_CELL);
-  yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: 1");
-  const fs::path cell = dir / "cell.yaml";
-  std::ofstream(cell) << yaml;
+  const fs::path cell = cell_with_max_twins(dir, 1);
   test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
                          "--state-dir", state.string()},
                         (dir / "up.log").string());
