@@ -24,6 +24,9 @@
 namespace dds {
 
 constexpr std::uint32_t kMaxParticipantsPerHost = 32;
+// Every discovery port a participant on a host can take: a process's first participant takes
+// the first free one of 100 (Fast DDS's mutation_tries), its second one past it.
+constexpr std::uint32_t kDiscoveryPortsPerHost = 128;
 
 // Says when another participant's lease ran out while it may still live (a process starved
 // of CPU for the whole lease): until discovery matches the two again, what they write to
@@ -209,19 +212,28 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
     // An initial peer stands for the discovery ports of participants 0..N-1 at its address;
     // Fast DDS's default N is 4, and a cell has more processes than that (the sixth one was
     // never discovered). 32 covers a cell, its twins and cellctl.
-    udp->maxInitialPeersRange = kMaxParticipantsPerHost;
+    // A discovery server takes them as initial peers too, with every port a participant can
+    // have: Fast DDS 2.9.1's server announces itself straight to the clients in its database,
+    // and a client that has just arrived there may not have its sender yet (made when its
+    // endpoints are matched, on another thread). Sending to a locator without one fails an
+    // assertion in the transport's traffic statistics and aborts the server (fixed upstream
+    // in Fast DDS PR #5704, 2025). Seen in CI with 57 participants starting at once; the
+    // discovery server test provokes it. Initial peers get their senders when it starts.
+    const bool serves = settings.discovery.serve >= 0;
+    udp->maxInitialPeersRange = serves ? kDiscoveryPortsPerHost : kMaxParticipantsPerHost;
     qos.transport().user_transports.push_back(udp);
-    if (settings.discovery.servers.empty()) {
+    if (settings.discovery.servers.empty() || serves) {
       for (const auto& address : peers) qos.wire_protocol().builtin.initialPeersList.push_back(udp_locator(name, address, 0));
     }
   }
-  // Announce the participant every 0.5 s instead of 3 s: a first announcement that no one
+  // Announce the participant every 0.5 s (by default) instead of 3 s: a first announcement that no one
   // heard (a process starting while others start) otherwise delays discovery by seconds.
   // The discovery lease stays Fast DDS's 20 s: with 5 s, a process starved of CPU for 5 s
   // (ten twins under ThreadSanitizer on two cores) was dropped by the others, and the pair
   // did not match again: every answer of a live buffer to one twin was lost. A process that
   // dies is noticed by the 5 s liveliness of its capability, not by this lease.
-  qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
+  qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
+      eprosima::fastrtps::Duration_t(settings.discovery.announce_every_s);
   qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(20.0);
   if (settings.discovery.serve >= static_cast<int>(settings.discovery.servers.size())) {
     throw std::runtime_error("DDS participant '" + name + "': it serves discovery as server " +

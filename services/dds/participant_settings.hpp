@@ -24,6 +24,7 @@ struct SecuritySettings {
 struct DiscoverySettings {
   std::vector<std::string> servers;  // "IP:PORT" each; a server's place in the list is its id
   int serve = -1;                    // this participant is servers[serve]; -1: a client of them all
+  double announce_every_s = 0.5;     // how often the participant announces itself (participant.cpp)
 };
 
 // "IP:PORT" -> {IP, PORT}; throws std::invalid_argument saying what is wrong.

@@ -9,7 +9,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -45,6 +47,21 @@ class ChildProcess {
     posix_spawn_file_actions_destroy(&actions);
     if (failed != 0) throw std::runtime_error("cannot start " + argv[0]);
   }
+  // A copy of this process that runs `body` and exits with what it returns (1 if it throws).
+  // Fork only from a test that has started no threads.
+  explicit ChildProcess(const std::function<int()>& body) {
+    std::fflush(nullptr);  // or the child writes what is buffered again
+    pid_ = ::fork();
+    if (pid_ < 0) throw std::runtime_error("cannot fork");
+    if (pid_ == 0) {
+      int code = 1;
+      try {
+        code = body();
+      } catch (...) {
+      }
+      ::_exit(code);
+    }
+  }
   ~ChildProcess() {
     if (pid_ > 0) {
       ::kill(pid_, SIGKILL);
@@ -55,6 +72,12 @@ class ChildProcess {
   ChildProcess& operator=(const ChildProcess&) = delete;
 
   pid_t pid() const { return pid_; }
+
+  // Whether it has not ended (one that ended is reaped).
+  bool running() {
+    if (pid_ > 0 && ::waitpid(pid_, nullptr, WNOHANG) == pid_) pid_ = -1;
+    return pid_ > 0;
+  }
 
   // SIGKILL: the process gets no chance to say goodbye (a crash, a power cut).
   void kill_hard() {
