@@ -19,6 +19,7 @@
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
 #include "deploy/cellctl/cell_roster.hpp"
+#include "deploy/cellctl/resource_service.hpp"
 #include "deploy/cellctl/cell_status.hpp"
 #include "deploy/cellctl/dashboard.hpp"
 #include "deploy/cellctl/host_limits.hpp"
@@ -447,8 +448,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     CellObserver observer(cell.participant_settings("order-desk"));
     // Before anything starts: a port that is taken stops up here, and the page shows the start.
     const std::unique_ptr<Dashboard> page = dashboard_at ? open_dashboard(*dashboard_at, cell, observer) : nullptr;
-    const RosterWriter roster(observer.participant(), cell);
     state::CellStore store(cell.state_folder());
+    RosterWriter roster(observer.participant(), cell, out_of_service_in(store));
     store.journal("cellctl", "up", "", "domain " + std::to_string(cell.domain));
     bool world_lost = false;  // cell-sim restarts: the twins' virtual scenes went with it
     Supervisor supervisor(cell_processes(cell, executable_dir()), cell.restart,
@@ -495,6 +496,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       world_lost = false;
       remote.tend();
       desk.tend();
+      roster.update(out_of_service_in(store));  // the operator took a resource out of service, or back
       supervisor.end_unheard(heard_resources(observer), wait);
       if (const std::string why = supervisor.tend(); !why.empty()) {
         std::cerr << "error: " << why << "; stopping the cell. Look at that process's output above, fix the cause, "
@@ -592,7 +594,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       const cell::Capability& c = r.capability;
       const std::string refused =
           c.refused_commands() == 0 ? "" : std::to_string(c.refused_commands()) + ", last: " + c.last_refusal().to_string();
-      resources.add_row({id, c.kind().to_string(), r.alive ? "alive" : "gone", c.busy() ? "busy" : "idle",
+      const std::string state = !r.alive ? "gone" : c.out_of_service().to_string().empty() ? "alive" : "out of service";
+      resources.add_row({id, c.kind().to_string(), state, c.busy() ? "busy" : "idle",
                          std::to_string(c.queued_commands()), c.reserved_by().to_string(), waiting, stock, refused});
     }
     std::cout << "Cell on domain " << cell.domain << ": " << observer.resources().size() << " resources\n\n";
@@ -664,8 +667,30 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       return;
     }
     state::CellStore store(cell.state_folder());
-    const CancelAnswer answer = cancel_order(store, *cancelled, "the operator (cellctl)");
+    const ActionAnswer answer = cancel_order(store, *cancelled, "the operator (cellctl)");
     (answer.status == 200 ? std::cout : std::cerr) << (answer.status == 200 ? "" : "error: ") << answer.message << '\n';
+    exit_code = answer.status == 200 ? 0 : 1;
+  });
+
+  CLI::App* service = app.add_subcommand(
+      "service", "Take a resource of the cell out of service (it takes no new work; what it took on, it finishes) or back");
+  add_cell_options(service, *cell_options);
+  auto service_resource = std::make_shared<std::string>();
+  auto service_out = std::make_shared<std::string>();
+  service->add_option("resource", *service_resource, "The resource's id (cellctl status lists them)")->required();
+  auto* out_opt = service->add_option("--out", *service_out, "Take it out of service, saying why");
+  auto* back_opt = service->add_flag("--back", "Put it back into service");
+  out_opt->excludes(back_opt);
+  service->callback([cell_options, service_resource, service_out, out_opt, back_opt, &exit_code] {
+    if (out_opt->count() == 0 && back_opt->count() == 0) throw CLI::ValidationError("service", "say --out REASON or --back");
+    if (out_opt->count() > 0 && service_out->empty()) throw CLI::ValidationError("--out", "the reason must not be empty");
+    CellConfig cell = cell_options->load();
+    state::CellStore store(cell.state_folder());
+    const ActionAnswer answer = set_resource_service(cell, store, *service_resource, *service_out, "the operator (cellctl)");
+    (answer.status == 200 ? std::cout : std::cerr) << (answer.status == 200 ? "" : "error: ") << answer.message << '\n';
+    if (answer.status == 200 && running_state_dir(cell.domain).empty()) {
+      std::cout << "no cellctl up runs on domain " << cell.domain << ": the next one starts with it so\n";
+    }
     exit_code = answer.status == 200 ? 0 : 1;
   });
 

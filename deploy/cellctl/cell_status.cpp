@@ -6,6 +6,7 @@
 #include <set>
 
 #include "deploy/cellctl/order_desk.hpp"
+#include "deploy/cellctl/resource_service.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -71,6 +72,8 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer,
 
   json resources = json::array();
   const auto seen = observer.resources();
+  // What the operator asked, until the resource says so itself (a gone one never does).
+  const auto asked_out = store ? out_of_service_in(*store) : std::map<std::string, std::string>{};
   std::set<std::string> ids;
   for (const auto& id : cell.resource_ids()) ids.insert(id);
   for (const auto& [id, r] : seen) ids.insert(id);
@@ -81,6 +84,7 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer,
                      {"reserved_by", ""},
                      {"restarts", store ? store->count_events(process_of(cell, id), "restarted") : 0},
                      {"stock", json::object()}};
+    if (const auto out = asked_out.find(id); out != asked_out.end()) resource["out_of_service"] = out->second;
     if (it != seen.end()) {
       const cell::Capability& c = it->second.capability;
       for (const auto& s : c.stock()) resource["stock"][s.part_type().to_string()] = s.count();
@@ -94,6 +98,7 @@ nlohmann::json cell_status(const CellConfig& cell, const CellObserver& observer,
                        {"queued", c.queued_commands()},
                        {"refused", c.refused_commands()},
                        {"last_refusal", c.last_refusal().to_string()},
+                       {"out_of_service", c.out_of_service().to_string()},
                        {"position", xyz(c.position())},
                        {"dock", xyz(c.dock())}});
     }

@@ -17,11 +17,12 @@ double unix_seconds(std::chrono::system_clock::time_point t) {
 }
 
 // The journal's events an operator must see: a process that ended, hung or restarted, the
-// whole cell restarted, parts held for inspection, an order that failed or left its plan.
+// whole cell restarted, parts held for inspection, an order that failed or left its plan, a
+// resource taken out of service or back.
 bool is_alarm(const state::JournalEntry& e) {
-  static const std::set<std::string> alarms{"ended",       "unheard", "restarting all", "inspection",
-                                            "FAILED",      "aborted", "plan not followed", "unexpected on_station",
-                                            "INTERRUPTED", "returned"};
+  static const std::set<std::string> alarms{"ended",       "unheard",  "restarting all", "inspection",
+                                            "FAILED",      "aborted",  "plan not followed", "unexpected on_station",
+                                            "INTERRUPTED", "returned", "out of service", "in service"};
   return alarms.count(e.event) > 0 || (e.event == "restarted" && e.source != "cellctl");
 }
 
@@ -142,6 +143,12 @@ json DashboardFeed::attention(const json& status) const {
   json out = json::array();
   for (const auto& r : status["resources"]) {
     if (!r["alive"].get<bool>()) out.push_back({{"severity", "alarm"}, {"what", r["id"].get<std::string>() + " is gone"}});
+  }
+  for (const auto& r : status["resources"]) {
+    if (!r.value("out_of_service", std::string()).empty()) {
+      out.push_back({{"severity", "warning"},
+                     {"what", r["id"].get<std::string>() + " is out of service: " + r["out_of_service"].get<std::string>()}});
+    }
   }
   for (const auto& [type, c] : status["inventory"].items()) {
     if (!c["conserved"].get<bool>()) {

@@ -9,6 +9,7 @@
 
 #include "deploy/cellctl/dashboard_assets.hpp"
 #include "deploy/cellctl/order_intake.hpp"
+#include "deploy/cellctl/resource_service.hpp"
 #include "services/state/cell_store.hpp"
 #include "twin/report/viewer/viewer_assets.hpp"
 
@@ -195,10 +196,23 @@ void DashboardRoutes::install(httplib::Server& s) {
   s.Post(R"(/orders/([A-Za-z0-9_.-]{1,128})/cancel)", [this](const httplib::Request& req, httplib::Response& res) {
     const std::string order = req.matches[1];
     state::CellStore store(cell_.state_folder());
-    const CancelAnswer answer = cancel_order(store, order, "the operator (dashboard)");
+    const ActionAnswer answer = cancel_order(store, order, "the operator (dashboard)");
     res.status = answer.status;
     res.set_content(nlohmann::json{{"order", order}, {"message", answer.message}}.dump(), "application/json");
   });
+  // Out of service, the body saying why (plain text), and back.
+  s.Post(R"(/resources/([A-Za-z0-9_.-]{1,128})/(out-of-service|in-service))",
+         [this](const httplib::Request& req, httplib::Response& res) {
+           const std::string resource = req.matches[1];
+           const bool out = req.matches[2] == "out-of-service";
+           ActionAnswer answer{400, "say why it goes out of service (the request's body)"};
+           if (!out || !req.body.empty()) {
+             state::CellStore store(cell_.state_folder());
+             answer = set_resource_service(cell_, store, resource, out ? req.body : "", "the operator (dashboard)");
+           }
+           res.status = answer.status;
+           res.set_content(nlohmann::json{{"resource", resource}, {"message", answer.message}}.dump(), "application/json");
+         });
   s.Post("/orders", [this](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& content) {
     take_upload(req, res, content);
   });

@@ -87,7 +87,7 @@ UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::s
   return {200, order, "order " + order + " (" + product + ") handed to the cell"};
 }
 
-CancelAnswer cancel_order(state::CellStore& store, const std::string& order, const std::string& who) {
+ActionAnswer cancel_order(state::CellStore& store, const std::string& order, const std::string& who) {
   const auto orders = store.orders();
   const auto o = std::find_if(orders.begin(), orders.end(), [&](const auto& r) { return r.order == order; });
   if (o == orders.end()) return {404, "the cell has no order " + order};

@@ -39,13 +39,14 @@ struct UploadAnswer {
 UploadAnswer take_upload(const CellConfig& cell, state::CellStore& store, std::string_view zip, std::string order,
                          const std::string& who);
 
-struct CancelAnswer {
-  int status = 200;  // as HTTP says it: 200 asked, 404 no such order, 409 it has ended
+// The answer to an operator's action (a cancel, a resource out of service or back).
+struct ActionAnswer {
+  int status = 200;  // as HTTP says it: 200 done or asked, 400 bad ask, 404 no such order or resource, 409 too late
   std::string message;
 };
 
 // Asks that the order be cancelled (CellStore::request_cancel), journalled with `who` ("the
 // operator (dashboard)"): its reason will read "cancelled by WHO".
-CancelAnswer cancel_order(state::CellStore& store, const std::string& order, const std::string& who);
+ActionAnswer cancel_order(state::CellStore& store, const std::string& order, const std::string& who);
 
 }  // namespace cellctl

@@ -24,13 +24,13 @@ const Topics kEveryone = {"cell/reader_slots"};
 
 // What every resource does (services/node/resource_node.cpp): its capability and command
 // events, bids and award replies; it reads calls, awards, releases, cancels, the orders'
-// status and the clock.
+// status, the clock and the cell's roster (whether the operator took it out of service).
 Grant resource(const std::string& id, const std::string& role, const Topics& own_command_topics, bool moves) {
   Grant g{id, role, {id},
           {"cell/capabilities", "cell/command_events", "cell/negotiation/proposals", "cell/negotiation/replies"},
           own_command_topics + Topics{"cell/cancel_requests", "cell/negotiation/calls", "cell/negotiation/awards",
                                       "cell/negotiation/releases", "cell/orders/status", "cell/orders/twins",
-                                      "cell/clock"} + kEveryone};
+                                      "cell/clock", "cell/roster"} + kEveryone};
   if (moves) {  // it asks cell-sim to move its bodies
     g.publish.push_back("cell/sim/requests");
     g.subscribe.push_back("cell/sim/replies");

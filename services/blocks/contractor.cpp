@@ -15,6 +15,7 @@ Contractor::Contractor(std::string name, std::string resource_id, std::set<std::
   declare_input("RELEASE", {"order_id", "resource_id"});
   declare_input("ORDER_ENDED", {"order_id"});
   declare_input("IDLE");
+  declare_input("SERVICE", {"out_of_service"});
   declare_output("PROPOSE", {"call_id", "available", "reason", "earliest_start", "duration", "bid_time"});
   declare_output("REPLY", {"call_id", "confirmed", "reason", "ahead"});
   declare_output("RESERVED", {"order_id"});
@@ -27,6 +28,7 @@ Contractor::Contractor(std::string name, std::string resource_id, std::set<std::
   transition("READY", "RELEASE", "READY", [this](const Data& d) { end(get<std::string>(d, "order_id")); }, for_me);
   transition("READY", "ORDER_ENDED", "READY", [this](const Data& d) { end(get<std::string>(d, "order_id")); });
   transition("READY", "IDLE", "READY", [this](const Data&) { busy_until_ = now_(); });
+  transition("READY", "SERVICE", "READY", [this](const Data& d) { out_of_service_ = get<std::string>(d, "out_of_service"); });
 }
 
 std::vector<std::string> Contractor::waiting() const {
@@ -73,6 +75,8 @@ std::string Contractor::refusal(const std::string& order, const std::string& awa
   return holder_.calls.count(award) ? "" : resource_id_ + " has no award " + award + of_order;
 }
 
+std::string Contractor::out_of_service_reason() const { return resource_id_ + " is out of service: " + out_of_service_; }
+
 // Exclusive: after the holder's expected end and the expected holds of those waiting.
 // Shared: after the work taken on.
 double Contractor::earliest_start(const std::string& order, double now) const {
@@ -90,9 +94,10 @@ void Contractor::propose(const Data& call) {
   // A call from the network is checked before the device is asked.
   const double hold = get_or<double>(call, "duration", 0);
   const std::int64_t count = get_or<std::int64_t>(call, "count", 0);
-  const Estimate e = !std::isfinite(hold) || hold < 0 ? Estimate{false, "the call's duration is not a number >= 0", 0}
-                     : count < 0                    ? Estimate{false, "the call's count is negative", 0}
-                                                    : estimate_(call);
+  const Estimate e = !out_of_service_.empty()          ? Estimate{false, out_of_service_reason(), 0}
+                     : !std::isfinite(hold) || hold < 0 ? Estimate{false, "the call's duration is not a number >= 0", 0}
+                     : count < 0                        ? Estimate{false, "the call's count is negative", 0}
+                                                        : estimate_(call);
   const std::string& id = get<std::string>(call, "call_id");
   if (e.available) {
     Data offered = call;
@@ -122,6 +127,10 @@ void Contractor::award(const Data& d) {
   }
   const auto bid = bids_.find(call);
   if (bid == bids_.end()) return reply(call, order, false, resource_id_ + " made no offer for call " + call, 0);
+  if (!out_of_service_.empty()) {
+    bids_.erase(bid);
+    return reply(call, order, false, out_of_service_reason(), 0);
+  }
   if (get<std::string>(bid->second, "order_id") != order) {
     return reply(call, order, false, "call " + call + " was made by order " + get<std::string>(bid->second, "order_id"), 0);
   }

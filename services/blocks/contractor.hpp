@@ -19,6 +19,9 @@
 //   RELEASE (order_id, resource_id)                RESERVED (order_id): the holder changed, or the queue
 //   ORDER_ENDED (order_id)                         AWARDED  (the call's data, duration): work taken on
 //   IDLE: the device has no work left (a shared resource's queue estimate starts again from now)
+//   SERVICE (out_of_service): the operator's word (the cell's roster); not "": why it is out of
+//     service. Then every call is refused with that reason, and so is an award of a bid made
+//     before; the orders that hold it or wait for it, and the work it took on, it still does.
 
 #include <deque>
 #include <functional>
@@ -48,6 +51,7 @@ class Contractor : public BasicBlock {
   const std::set<std::string>& offers() const { return offers_; }
 
   const std::string& reserved_by() const { return holder_.order; }
+  const std::string& out_of_service() const { return out_of_service_; }
   std::vector<std::string> waiting() const;
   // What the resource has taken on: the order that holds it and those waiting, in turn
   // (exclusive), or the orders whose work it took (shared), with the awards of each. A
@@ -77,6 +81,7 @@ class Contractor : public BasicBlock {
     std::set<std::string> calls;  // the awards it holds this resource by
   };
   double earliest_start(const std::string& order, double now) const;
+  std::string out_of_service_reason() const;
   void award(const Data& award);
   long place_of(const std::string& order, const std::string& call) const;
   void end(const std::string& order);
@@ -93,6 +98,7 @@ class Contractor : public BasicBlock {
   std::map<std::string, Data> bids_;           // call id -> the call offered for, with the bid's duration
   std::map<std::string, std::set<std::string>> work_;  // shared: order -> awards taken on
   double busy_until_ = 0;                      // shared: the end of the work taken on
+  std::string out_of_service_;                 // why it takes no new work; "" in service
   std::function<void(const std::vector<Booking>&)> persist_;
   void persist() const {
     if (persist_) persist_(bookings());

@@ -339,7 +339,8 @@ fb::Data to_data(const cell::Capability& c) {
           {"queued_commands", std::int64_t(c.queued_commands())},
           {"busy", c.busy()},
           {"refused_commands", std::int64_t(c.refused_commands())},
-          {"last_refusal", c.last_refusal().to_string()}};
+          {"last_refusal", c.last_refusal().to_string()},
+          {"out_of_service", c.out_of_service().to_string()}};
 }
 
 }  // namespace dds

@@ -9,6 +9,7 @@
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
 #include "negotiationPubSubTypes.h"
+#include "rosterPubSubTypes.h"
 #include "services/blocks/action_block.hpp"
 #include "services/dds/conversions.hpp"
 #include "services/dds/order_watch.hpp"
@@ -147,6 +148,7 @@ struct ResourceNode::Impl {
     c.busy(busy);
     overflowed_published = overflowed;
     c.refused_commands(static_cast<int32_t>(device.refused() + overflowed_published));
+    c.out_of_service(contractor->out_of_service());
     {
       std::lock_guard<std::mutex> lock(refusal_mutex);
       const std::string& last = last_overflow.empty() ? device.last_refusal() : last_overflow;
@@ -389,6 +391,16 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
   resource.connect("contractor", "REPLY", "award_replies", "REQ");
   resource.add(std::make_unique<fb::ActionBlock>("capability", [this](const fb::Data&) { publish_capability(); }));
   resource.connect("contractor", "RESERVED", "capability", "REQ");
+  // The operator's word on this resource, in the cell's roster: out of service, or back.
+  n.subscribe<cell::CellRoster, cell::CellRosterPubSubType>(
+      "roster", "cell/roster", TopicKind::state, [id](const cell::CellRoster& roster) {
+        for (const auto& e : roster.resources()) {
+          if (e.resource_id().to_string() == id) return fb::Data{{"out_of_service", e.out_of_service().to_string()}};
+        }
+        return fb::Data{};  // a roster that does not name it
+      });
+  resource.connect("roster", "IND", "contractor", "SERVICE");
+  resource.connect("roster", "IND", "capability", "REQ");
   if (device.has_output("CAPABILITY")) resource.connect(dev, "CAPABILITY", "capability_refresh", "CHANGED");
   resource.connect(dev, "REFUSE", "capability_refresh", "CHANGED");
 

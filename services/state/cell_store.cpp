@@ -35,6 +35,8 @@ CREATE TABLE IF NOT EXISTS orders(
   path_planner TEXT NOT NULL DEFAULT '', exit_code INTEGER, attempts INTEGER NOT NULL DEFAULT 0,
   quote INTEGER NOT NULL DEFAULT 0, client TEXT NOT NULL DEFAULT '', request TEXT NOT NULL DEFAULT '',
   cancelled_by TEXT NOT NULL DEFAULT '');
+CREATE TABLE IF NOT EXISTS out_of_service(
+  resource TEXT PRIMARY KEY, reason TEXT NOT NULL, by TEXT NOT NULL, since REAL NOT NULL);
 CREATE TABLE IF NOT EXISTS plan_steps(
   order_id TEXT NOT NULL, position INTEGER NOT NULL, step TEXT NOT NULL, trajectory TEXT NOT NULL,
   PRIMARY KEY(order_id, position));
@@ -520,6 +522,24 @@ std::string CellStore::cancel_requested(const std::string& order) const {
   Statement row(db_, "SELECT cancelled_by FROM orders WHERE order_id = ?");
   row.bind(order);
   return row.step() ? row.text(0) : "";
+}
+
+void CellStore::set_out_of_service(const std::string& resource, const std::string& reason, const std::string& by) {
+  if (reason.empty()) {
+    Statement(db_, "DELETE FROM out_of_service WHERE resource = ?").bind(resource).step();
+    return;
+  }
+  Statement(db_, "INSERT INTO out_of_service(resource, reason, by, since) VALUES(?, ?, ?, ?) "
+                 "ON CONFLICT(resource) DO UPDATE SET reason = excluded.reason, by = excluded.by, since = excluded.since")
+      .bind(resource, reason, by, unix_now())
+      .step();
+}
+
+std::map<std::string, ServiceRecord> CellStore::out_of_service() const {
+  std::map<std::string, ServiceRecord> out;
+  Statement rows(db_, "SELECT resource, reason, by, since FROM out_of_service");
+  while (rows.step()) out[rows.text(0)] = {rows.text(1), rows.text(2), rows.real(3)};
+  return out;
 }
 
 int CellStore::count_attempt(const std::string& order) {

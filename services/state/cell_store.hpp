@@ -81,6 +81,12 @@ struct PlanStepRecord {
   bool operator==(const PlanStepRecord& o) const { return step == o.step && trajectory == o.trajectory; }
 };
 
+// A resource the operator took out of service.
+struct ServiceRecord {
+  std::string reason, by;
+  double since = 0;  // Unix time, s
+};
+
 struct JournalEntry {
   long seq = 0;
   double time = 0;  // Unix time, s
@@ -167,6 +173,12 @@ class CellStore {
   bool request_cancel(const std::string& order, const std::string& who);
   // Who asked to cancel the order; "" when nobody did.
   std::string cancel_requested(const std::string& order) const;
+  // Takes the resource out of service, saying why (it takes no new work; what it took on it
+  // finishes), or with `reason` "" back into service. The cell's roster carries it to the
+  // resource (cellctl up).
+  void set_out_of_service(const std::string& resource, const std::string& reason, const std::string& by);
+  // The resources out of service, by id.
+  std::map<std::string, ServiceRecord> out_of_service() const;
   // One more twin started for the order; the attempts so far.
   int count_attempt(const std::string& order);
   std::vector<OrderRecord> orders() const;  // in the order they came

@@ -294,3 +294,102 @@ TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes a
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(cell.up->wait_for_exit(20s) == 0);
 }
+
+TEST_CASE("the operator takes a station out of service from the dashboard: the station says so and refuses new work with "
+          "the reason, and the order that needed it fails with it, and back in service from the command line it builds the next",
+          "[process][cell][dashboard]") {
+  using namespace std::chrono_literals;
+  const auto dir = test::scratch("dashboard-service");
+  const std::string domain = "169";
+  const DashboardCell cell = start_dashboard_cell(dir, domain);
+  const httplib::Headers bearer{{"Authorization", "Bearer " + cell.token}};
+  httplib::Client client("127.0.0.1", cell.port);
+  client.set_read_timeout(30, 0);
+  const auto state_of = [&] {
+    const auto r = client.Get("/state", bearer);
+    REQUIRE(r);
+    return nlohmann::json::parse(r->body);
+  };
+  const auto resource = [](const nlohmann::json& state, const std::string& id) {
+    for (const auto& r : state["resources"]) {
+      if (r["id"] == id) return r;
+    }
+    return nlohmann::json::object();
+  };
+
+  // A stranger, another site, an unknown resource, no reason, a control character: refused.
+  const char* out = "/resources/station-1/out-of-service";
+  auto r = client.Post(out, "worn", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 401);
+  auto foreign = bearer;
+  foreign.emplace("Origin", "http://evil.example");
+  r = client.Post(out, foreign, "worn", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 403);
+  r = client.Post("/resources/station-9/out-of-service", bearer, "worn", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 404);
+  r = client.Post(out, bearer, "", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 400);
+  r = client.Post(out, bearer, "worn\x1b[2J", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 400);
+
+  // The operator's ask reaches the station, which says so in its capability.
+  r = client.Post(out, bearer, "gripper worn", "text/plain");
+  REQUIRE(r);
+  CHECK(r->status == 200);
+  const std::string why = "gripper worn (the operator (dashboard))";
+  bool said = false;
+  for (auto until = std::chrono::steady_clock::now() + 30s; !said && std::chrono::steady_clock::now() < until;
+       std::this_thread::sleep_for(200ms)) {
+    said = resource(state_of(), "station-1").value("out_of_service", "") == why;
+  }
+  CHECK(said);
+  CHECK(test::cellctl({"status", "--domain", domain}, dir / "status.log", 30s) == 0);
+  CHECK(test::read_text(dir / "status.log").find("out of service") != std::string::npos);
+
+  // An order needs the cell's one station: every call is refused with the reason, and after
+  // the twin's wait (30 s) the order fails with it.
+  const std::string zip = test::read_text(LEGO_ZIP);
+  r = client.Post("/orders?order=o-out", bearer, zip, "application/zip");
+  REQUIRE(r);
+  REQUIRE(r->status == 200);
+  const auto final_state = [&](const std::string& order, nlohmann::json& found) {
+    for (auto until = std::chrono::steady_clock::now() + 120s; std::chrono::steady_clock::now() < until;
+         std::this_thread::sleep_for(250ms)) {
+      const auto state = state_of();
+      for (const auto& o : state["orders"]) {
+        if (o["order"] == order && (o["state"] == "DONE" || o["state"] == "FAILED")) {
+          found = o;
+          return o["state"].get<std::string>();
+        }
+      }
+    }
+    return std::string("not ended");
+  };
+  nlohmann::json order;
+  CHECK(final_state("o-out", order) == "FAILED");
+  INFO(order.dump());
+  CHECK(order.value("reason", "").find("station-1 is out of service: " + why) != std::string::npos);
+  CHECK(resource(state_of(), "station-1").value("reserved_by", "x").empty());
+
+  // Back, from the command line: the next order is built on it.
+  CHECK(test::cellctl({"service", "station-1", "--back", "--domain", domain}, dir / "back.log", 30s) == 0);
+  CHECK(test::read_text(dir / "back.log").find("station-1 is back in service") != std::string::npos);
+  r = client.Post("/orders?order=o-back", bearer, zip, "application/zip");
+  REQUIRE(r);
+  REQUIRE(r->status == 200);
+  CHECK(final_state("o-back", order) == "DONE");
+  CHECK(resource(state_of(), "station-1").value("out_of_service", "x").empty());
+  // The alarms have both, and whose they were.
+  const std::string alarms = state_of()["alarms"].dump();
+  CHECK(alarms.find("out of service") != std::string::npos);
+  CHECK(alarms.find("in service") != std::string::npos);
+  CHECK(alarms.find("the operator (dashboard)") != std::string::npos);
+  CHECK(alarms.find("the operator (cellctl)") != std::string::npos);
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(cell.up->wait_for_exit(20s) == 0);
+}

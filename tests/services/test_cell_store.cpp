@@ -211,6 +211,28 @@ TEST_CASE("a cancel is asked of an order that has not ended, and says who asked,
   CHECK(orders[1].cancelled_by.empty());
 }
 
+TEST_CASE("a resource out of service stays so, with why and who, across a reopening, until it is put back", "[state]") {
+  const auto dir = fresh_dir("service");
+  {
+    state::CellStore store(dir);
+    CHECK(store.out_of_service().empty());
+    store.set_out_of_service("arm-1", "gripper worn", "the operator (cellctl)");
+    store.set_out_of_service("rack-a", "restocking", "the operator (dashboard)");
+    store.set_out_of_service("arm-1", "gripper replaced, calibrating", "the operator (dashboard)");
+  }
+  state::CellStore store(dir);
+  auto out = store.out_of_service();
+  REQUIRE(out.size() == 2);
+  CHECK(out["arm-1"].reason == "gripper replaced, calibrating");
+  CHECK(out["arm-1"].by == "the operator (dashboard)");
+  CHECK(out["arm-1"].since > 0);
+  CHECK(out["rack-a"].reason == "restocking");
+  store.set_out_of_service("arm-1", "", "the operator (cellctl)");
+  out = store.out_of_service();
+  CHECK(out.size() == 1);
+  CHECK(out.count("rack-a") == 1);
+}
+
 TEST_CASE("the commands a resource had taken on are answered once by the process after it", "[state]") {
   state::CellStore store(fresh_dir("commands"));
   store.command_taken({"robot-1", "o1/c1", "o1", "fetch", "o1/peg"});

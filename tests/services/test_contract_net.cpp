@@ -116,6 +116,36 @@ TEST_CASE("contractor: a refusal says why", "[fb][negotiation]") {
   CHECK(fb::get<std::string>(refusal[0].data, "reason") == "buffer-1 has 0 Shaft free, not 1");
 }
 
+TEST_CASE("contractor: out of service, it bids for nothing and takes no award, and serves the orders it took on",
+          "[fb][negotiation]") {
+  now = 100;
+  fb::BlockTestFixture<fb::Contractor> f("contractor", "station-1", std::set<std::string>{"host"}, true, holds(),
+                                         [] { return now; });
+  f.send("CFP", cfp("o1", "host", 30));
+  REQUIRE(fb::get<bool>(f.send("AWARD", award("o1", "host"))[0].data, "confirmed"));
+  f.send("CFP", cfp("o2", "host", 20));  // o2's bid is made in service, its award comes after
+  REQUIRE(f.send("SERVICE", {{"out_of_service", std::string("gripper worn (the operator)")}}).empty());
+  CHECK(f.block().out_of_service() == "gripper worn (the operator)");
+
+  const auto refused = f.send("CFP", cfp("o3", "host", 20));
+  REQUIRE(fb::event_names(refused) == Names{"PROPOSE"});
+  CHECK_FALSE(fb::get<bool>(refused[0].data, "available"));
+  CHECK(fb::get<std::string>(refused[0].data, "reason") == "station-1 is out of service: gripper worn (the operator)");
+  const auto late = f.send("AWARD", award("o2", "host"));
+  REQUIRE(fb::event_names(late) == Names{"REPLY"});
+  CHECK_FALSE(fb::get<bool>(late[0].data, "confirmed"));
+  CHECK(fb::get<std::string>(late[0].data, "reason") == "station-1 is out of service: gripper worn (the operator)");
+  CHECK(f.block().waiting().empty());
+  // The order that holds it goes on: its commands are authorised, its award confirmed again.
+  CHECK(f.block().refusal("o1", "o1/host").empty());
+  CHECK(fb::get<bool>(f.send("AWARD", award("o1", "host"))[0].data, "confirmed"));
+
+  f.send("SERVICE", {{"out_of_service", std::string()}});
+  const auto again = f.send("CFP", cfp("o3", "host", 20));
+  CHECK(fb::get<bool>(again[0].data, "available"));
+  CHECK(fb::get<double>(again[0].data, "earliest_start") == 130);  // after o1
+}
+
 namespace {
 
 fb::Data capability(const std::string& id, const std::string& operations) {

@@ -38,20 +38,40 @@
 
   function renderResources(resources) {
     fill(document.querySelector("#resources tbody"), resources.map((r) => {
-      const word = !r.alive ? "gone" : r.busy ? "busy" : "idle";
+      const word = !r.alive ? "gone" : r.out_of_service ? "out of service" : r.busy ? "busy" : "idle";
       const seen = (page.seen[r.id] = page.seen[r.id] || []);
       if (seen[seen.length - 1] !== word) seen.push(word);
       const ago = r.restarted_at ? Date.now() / 1000 - r.restarted_at : Infinity;
       const state = el("span", word + (r.alive && ago < 60 ? ", restarted " + Math.round(ago) + " s ago" : ""),
-                       r.alive && ago < 60 ? "back" : word);
+                       r.alive && ago < 60 ? "back" : word.replaceAll(" ", "-"));
+      if (r.out_of_service) state.title = r.out_of_service;
       const doing = r.current ? r.current.operation + (r.current.part ? " " + r.current.part : "") + " (" + r.current.order + ")" : "";
       const types = Object.entries(r.stock || {});
       const stock = el("span", types.length ? types.reduce((sum, [, n]) => sum + n, 0) + " parts of " + types.length + " types" : "");
       stock.title = types.map(([t, n]) => t + " " + n).join(", ");
       const refused = r.refused ? r.refused + (r.last_refusal ? ": " + r.last_refusal : "") : "";
       return [r.id, r.kind || "", state, doing, r.reserved_by || "", (r.waiting || []).join(", "), r.queued ?? "", refused,
-              r.restarts || 0, stock];
+              r.restarts || 0, stock, serviceButton(r.id, !!r.out_of_service)];
     }));
+  }
+  // Out of service (asking why) and back: a button per resource and way, kept across redraws.
+  const serviceButtons = new Map();
+  function serviceButton(resource, out) {
+    const key = resource + (out ? "/back" : "/out");
+    if (serviceButtons.has(key)) return serviceButtons.get(key);
+    const button = el("button", out ? "back into service" : "out of service", "service");
+    button.addEventListener("click", async () => {
+      const why = out ? "" : window.prompt("Take " + resource + " out of service: why? It takes no new work; what it took on, it finishes.");
+      if (!out && !why) return;
+      const way = out ? "/in-service" : "/out-of-service";
+      const response = await fetch("/resources/" + encodeURIComponent(resource) + way, { method: "POST", body: why })
+        .catch((error) => ({ ok: false, text: async () => JSON.stringify({ message: error.message }) }));
+      const answer = document.getElementById("submit-answer");
+      answer.textContent = await messageOf(response);
+      answer.className = response.ok ? "answer-ok" : "answer-refused";
+    });
+    serviceButtons.set(key, button);
+    return button;
   }
   function renderOrders(orders) {
     fill(document.querySelector("#orders tbody"), orders.map((o) => {
@@ -178,7 +198,7 @@
   function renderScene(resources) {
     if (!scene.ready) return;
     // Software rendering takes tens of ms: only when something in the view changed.
-    const key = JSON.stringify(resources.map((r) => [r.id, r.alive, r.busy, r.position]));
+    const key = JSON.stringify(resources.map((r) => [r.id, r.alive, r.busy, r.out_of_service, r.position]));
     if (key === scene.key) return;
     scene.key = key;
     for (const r of resources) {
@@ -191,7 +211,7 @@
       }
       const lift = r.kind === "arm" ? 0.25 : r.kind === "station" ? -0.025 : 0.15;
       mesh.position.set(r.position[0], r.position[1] + lift, r.position[2]);
-      mesh.material.color.set(!r.alive ? 0xb00020 : r.busy ? 0x0b5cad : r.kind === "station" ? 0x9aa5b1 : 0x2e7d32);
+      mesh.material.color.set(!r.alive ? 0xb00020 : r.out_of_service ? 0x5f6368 : r.busy ? 0x0b5cad : r.kind === "station" ? 0x9aa5b1 : 0x2e7d32);
     }
     scene.renderer.render(scene.three, scene.camera);
     document.body.dataset.scene = "drawn";
