@@ -2,9 +2,9 @@
 // `cellctl up --dashboard` on a domain of its own, opens the address it printed, and checks
 // what a person would see: every resource of the cell; a file that is not a product's zip
 // refused with the reason; an order submitted through the page's form (the product's zip)
-// advancing to DONE, its report opening from the page's link; one cancelled from its row; a killed buffer turning gone,
-// then back; no console error; no request
-// to anything but the dashboard. Prints the page's update latency (a DDS event heard by
+// advancing to DONE, its report opening from the page's link; one cancelled from its row; a
+// killed buffer turning gone, then back; the robot taken out of service from its row, with the
+// reason shown, and back; no console error; no request to anything but the dashboard. Prints the page's update latency (a DDS event heard by
 // cellctl up to the page's state drawn, p50 and p99) and can keep a screenshot of the page at
 // work. DASHBOARD_ORDERS=N submits N orders more (the latency of a busy cell).
 //   node check_dashboard.js CELLCTL CELL.yaml DOMAIN PRODUCT.aml PRODUCT.zip [SCREENSHOT.png]
@@ -182,6 +182,32 @@ function percentile(values, p) {
       const reason = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-c")
         .map((tr) => tr.cells[5].textContent).join(""));
       if (!reason.startsWith("cancelled by the operator (dashboard)")) problems.push("dash-c failed for another reason: " + reason);
+    }
+    // The operator takes the robot out of service from its row (the page asks why), and back.
+    const robot = ids.find((id) => id.startsWith("mobile-robot"));
+    const serviceButton = (id, text) => page.waitForFunction((id, text) => {
+      const row = [...document.querySelectorAll("#resources tbody tr")].find((tr) => tr.cells[0].textContent === id);
+      return row && [...row.querySelectorAll("button.service")].find((b) => b.textContent === text);
+    }, { timeout: 20000 }, id, text).catch(() => null);
+    const out = await serviceButton(robot, "out of service");
+    if (!out) {
+      problems.push(robot + " has no out-of-service button");
+    } else {
+      const asked = new Promise((resolve) => page.once("dialog", (d) => d.accept("wheel check").then(resolve, resolve)));
+      await out.asElement().click();
+      await asked;
+      const back = await serviceButton(robot, "back into service");
+      const state = await page.$$eval("#resources tbody tr", (rows, id) => rows.filter((tr) => tr.cells[0].textContent === id)
+        .map((tr) => tr.cells[2].textContent + " | " + tr.cells[2].firstChild.title).join(""), robot);
+      if (!back || !state.startsWith("out of service | wheel check (the operator (dashboard))")) {
+        problems.push(robot + " did not show out of service with the reason: " + state);
+      }
+      if (back) {
+        await back.asElement().click();
+        await page.waitForFunction((id) => (window.dashboard.seen[id] || []).slice(-1)[0] !== "out of service", { timeout: 20000 }, robot)
+          .catch(async () => problems.push(robot + " did not come back into service: it went " +
+                                           JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], robot))));
+      }
     }
     const drawn = await page.evaluate(() => document.body.dataset.scene);
     if (drawn !== "drawn") problems.push("the 3D view was not drawn");
