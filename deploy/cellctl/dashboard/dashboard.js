@@ -51,7 +51,7 @@
       stock.title = types.map(([t, n]) => t + " " + n).join(", ");
       const refused = r.refused ? r.refused + (r.last_refusal ? ": " + r.last_refusal : "") : "";
       return [r.id, r.kind || "", state, doing, r.reserved_by || "", (r.waiting || []).join(", "), r.queued ?? "", refused,
-              r.restarts || 0, stock, serviceButton(r.id, !!r.out_of_service)];
+              r.restarts || 0, stock, r.kind === "simulation" ? "" : serviceButton(r.id, !!r.out_of_service)];
     }));
   }
   // Out of service (asking why) and back: a button per resource and way, kept across redraws.
