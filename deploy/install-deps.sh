@@ -31,6 +31,7 @@ if $tests; then
     libfcl-dev libopenvdb-dev libboost-iostreams-dev libbullet-extras-dev  # only for bench_collision_libraries:
                    # our check against FCL's, OpenVDB's distance fields (its CMake module wants Boost
                    # iostreams, which the package does not pull) and Bullet's HACD decomposition
+    libcivetweb-dev  # only for bench_http_servers: the dashboard's HTTP library against civetweb
     chromium ffmpeg  # cellctl plan --video renders the report headless; the tests open it
     clang libclang-rt-14-dev  # the sanitizer builds and the libFuzzer targets (deploy/test.sh)
   )
