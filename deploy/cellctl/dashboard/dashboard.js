@@ -63,12 +63,7 @@
     button.addEventListener("click", async () => {
       const why = out ? "" : window.prompt("Take " + resource + " out of service: why? It takes no new work; what it took on, it finishes.");
       if (!out && !why) return;
-      const way = out ? "/in-service" : "/out-of-service";
-      const response = await fetch("/resources/" + encodeURIComponent(resource) + way, { method: "POST", body: why })
-        .catch((error) => ({ ok: false, text: async () => JSON.stringify({ message: error.message }) }));
-      const answer = document.getElementById("submit-answer");
-      answer.textContent = await messageOf(response);
-      answer.className = response.ok ? "answer-ok" : "answer-refused";
+      await act("/resources/" + encodeURIComponent(resource) + (out ? "/in-service" : "/out-of-service"), why);
     });
     serviceButtons.set(key, button);
     return button;
@@ -101,11 +96,7 @@
     button.addEventListener("click", async () => {
       if (!window.confirm("Cancel order " + order + "? Its twin fails it and the cell cleans up.")) return;
       button.disabled = true;
-      const response = await fetch("/orders/" + encodeURIComponent(order) + "/cancel", { method: "POST" })
-        .catch((error) => ({ ok: false, text: async () => JSON.stringify({ message: error.message }) }));
-      const answer = document.getElementById("submit-answer");
-      answer.textContent = await messageOf(response);
-      answer.className = response.ok ? "answer-ok" : "answer-refused";
+      await act("/orders/" + encodeURIComponent(order) + "/cancel");
     });
     cancelButtons.set(order, button);
     return button;
@@ -276,6 +267,18 @@
   async function messageOf(response) {
     const text = await response.text();
     try { return JSON.parse(text).message; } catch (ignored) { return text; }
+  }
+  // An operator's action (POST, `body` if any): the answer, or the refusal's reason, under the form.
+  async function act(url, body) {
+    const answer = document.getElementById("submit-answer");
+    try {
+      const response = await fetch(url, { method: "POST", body });
+      answer.textContent = await messageOf(response);
+      answer.className = response.ok ? "answer-ok" : "answer-refused";
+    } catch (error) {
+      answer.textContent = "the cell did not answer: " + error.message;
+      answer.className = "answer-refused";
+    }
   }
   // An order from a product's zip, through the cell's desk (POST /orders): the answer, or the
   // refusal's reason, under the form.
