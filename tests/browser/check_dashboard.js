@@ -48,6 +48,33 @@ function processOf(id) {
   return 0;
 }
 
+// Clicks the button `selector` (whose text is `text`, if given) in the row of `id` in table
+// `table`, and answers the question the click asks (`answer`: true to accept, the text to
+// type, or null when it asks none); false if there is no such button or the click asked nothing. The click is the page's
+// own: a mouse click at a button's place can miss it, as its row shifts whenever a cell's text
+// changes width ("restarted 9 s ago", then "10 s").
+async function clickInRow(page, table, id, selector, answer, text = null) {
+  let answered;
+  const asked = new Promise((resolve) => { answered = resolve; });
+  const onDialog = (d) => (answer === true ? d.accept() : d.accept(answer)).then(() => answered(true), () => answered(true));
+  page.once("dialog", onDialog);
+  const clicked = await page.waitForFunction((table, id, selector, text) => {
+    const row = [...document.querySelectorAll("#" + table + " tbody tr")].find((tr) => tr.cells[0].textContent === id);
+    const button = row && [...row.querySelectorAll(selector)].find((b) => text === null || b.textContent === text);
+    if (!button) return false;
+    setTimeout(() => button.click(), 0);  // after this check returns: the question stops the page's script
+    return true;
+  }, { timeout: 20000 }, table, id, selector, text).then(() => true, () => false);
+  let ok = clicked;
+  if (clicked && answer !== null) {
+    const timer = setTimeout(() => answered(false), 20000);
+    ok = await asked;
+    clearTimeout(timer);
+  }
+  page.off("dialog", onDialog);
+  return ok;
+}
+
 function percentile(values, p) {
   const sorted = [...values].sort((a, b) => a - b);
   return sorted[Math.min(sorted.length - 1, Math.floor(p * sorted.length))];
@@ -59,170 +86,170 @@ function percentile(values, p) {
   const up = spawn(cellctl, ["up", cellFile, "--domain", domain, "--state-dir", path.join(scratch, "state"),
                              "--dashboard", "127.0.0.1:0"], { stdio: ["ignore", fs.openSync(upLog, "w"), fs.openSync(upLog, "a")] });
   let browser;
+  let step = "starting the cell";
+  // ctest ends the test at 300 s, silently: at 280 it says where it stands, and ends the cell.
+  const deadline = new Promise((_, reject) => setTimeout(() => reject(new Error("still " + step + " after 280 s")), 280000).unref());
   try {
-    const url = (await appears(upLog, /dashboard: (http:\/\/127\.0\.0\.1:\d+\/\?token=[0-9a-f]+)/, 30))[1];
-    await appears(upLog, /cell up on domain/, 90);
-    const origin = new URL(url).origin;
+    await Promise.race([deadline, (async () => {
+      const url = (await appears(upLog, /dashboard: (http:\/\/127\.0\.0\.1:\d+\/\?token=[0-9a-f]+)/, 30))[1];
+      await appears(upLog, /cell up on domain/, 90);
+      const origin = new URL(url).origin;
 
-    browser = await launch(puppeteer);
-    const page = await browser.newPage();
-    await page.setViewport({ width: 1400, height: 1100 });
-    // The browser logs an answer 400 as an error: the one to the upload refused on purpose is not.
-    let refusing = false;
-    page.on("console", (m) => {
-      if (m.type() === "error" && !(refusing && /status of 400/.test(m.text()))) problems.push("console error: " + m.text());
-    });
-    page.on("pageerror", (e) => problems.push("page error: " + e.message));
-    page.on("request", (r) => {
-      if (!r.url().startsWith(origin + "/") && !r.url().startsWith("data:")) problems.push("requested " + r.url());
-    });
-    await page.goto(url, { waitUntil: "load" });
-    if (page.url() !== origin + "/") problems.push("the token stayed in the address: " + page.url());
+      step = "opening the page";
+      browser = await launch(puppeteer);
+      const page = await browser.newPage();
+      await page.setViewport({ width: 1400, height: 1100 });
+      // The browser logs an answer 400 as an error: the one to the upload refused on purpose is not.
+      let refusing = false;
+      page.on("console", (m) => {
+        if (m.type() === "error" && !(refusing && /status of 400/.test(m.text()))) problems.push("console error: " + m.text());
+      });
+      page.on("pageerror", (e) => problems.push("page error: " + e.message));
+      page.on("request", (r) => {
+        if (!r.url().startsWith(origin + "/") && !r.url().startsWith("data:")) problems.push("requested " + r.url());
+      });
+      await page.goto(url, { waitUntil: "load" });
+      if (page.url() !== origin + "/") problems.push("the token stayed in the address: " + page.url());
 
-    // Every resource of the cell, as cellctl status lists them.
-    const status = JSON.parse(spawnSync(cellctl, ["status", "--cell", cellFile, "--domain", domain, "--json"],
-                                        { encoding: "utf8" }).stdout);
-    const ids = status.resources.map((r) => r.id);
-    await page.waitForFunction((ids) => {
-      const shown = [...document.querySelectorAll("#resources tbody tr")].map((tr) => tr.cells[0].textContent);
-      return ids.every((id) => shown.includes(id));
-    }, { timeout: 20000 }, ids).catch(() => problems.push("the page does not show every resource: " + ids.join(", ")));
+      step = "looking for every resource";
+      // Every resource of the cell, as cellctl status lists them.
+      const status = JSON.parse(spawnSync(cellctl, ["status", "--cell", cellFile, "--domain", domain, "--json"],
+                                          { encoding: "utf8", timeout: 30000 }).stdout);
+      const ids = status.resources.map((r) => r.id);
+      await page.waitForFunction((ids) => {
+        const shown = [...document.querySelectorAll("#resources tbody tr")].map((tr) => tr.cells[0].textContent);
+        return ids.every((id) => shown.includes(id));
+      }, { timeout: 20000 }, ids).catch(() => problems.push("the page does not show every resource: " + ids.join(", ")));
 
-    // The page's form: a file that is not a zip is refused, with the reason shown; the
-    // product's zip becomes order dash-1.
-    const upload = async (file, id) => {
-      await page.evaluate(() => { document.getElementById("submit-answer").textContent = ""; });
-      await (await page.$("#submit-file")).uploadFile(file);
-      await page.$eval("#submit-id", (input, id) => { input.value = id; }, id);
-      await page.click("#submit-button");
-      await page.waitForFunction(() => /order|zip|archive|refused|larger|cell/.test(document.getElementById("submit-answer").textContent)
-        && !document.getElementById("submit-button").disabled, { timeout: 30000 });
-      return page.$eval("#submit-answer", (o) => ({ text: o.textContent, cls: o.className }));
-    };
-    refusing = true;
-    const refused = await upload(product, "dash-0");
-    refusing = false;
-    if (refused.cls !== "answer-refused" || !refused.text.includes("not a zip archive")) {
-      problems.push("an .aml sent as the product's zip was not refused with the reason: " + JSON.stringify(refused));
-    }
-    const taken = await upload(productZip, "dash-1");
-    if (taken.cls !== "answer-ok" || !taken.text.includes("dash-1")) problems.push("the product's zip was not taken: " + JSON.stringify(taken));
-    // DASHBOARD_ORDERS more, by cellctl, for a measurement of the latency while the cell is busy.
-    const extra = Number(process.env.DASHBOARD_ORDERS || 0);
-    const submits = [];
-    for (let i = 2; i <= 1 + extra; ++i) {
-      submits.push(spawn(cellctl, ["submit", product, "--domain", domain, "--order", "dash-" + i, "--out",
-                                   path.join(scratch, "dash-" + i), "--detach"], { stdio: "ignore" }));
-    }
-    const shows = (order, state) => page.waitForFunction((order, state) => [...document.querySelectorAll("#orders tbody tr")].some(
-      (tr) => tr.cells[0].textContent === order && tr.cells[1].textContent === state), { timeout: 150000 + 20000 * extra }, order, state);
-    if (screenshot) {  // the page at work
-      await shows("dash-1", "PHYSICAL_ASSEMBLY").then(() => sleep(800)).then(() => page.screenshot({ path: screenshot, fullPage: true }))
-        .catch(() => console.log("no screenshot: dash-1 was not seen in PHYSICAL_ASSEMBLY"));
-    }
-    for (let i = 1; i <= 1 + extra; ++i) {
-      await shows("dash-" + i, "DONE").catch(() => problems.push("order dash-" + i + " never showed DONE"));
-    }
-    submits.forEach((s) => s.kill("SIGTERM"));
-    // Its results, from the page's links: the report opens (sandboxed) with no error, the plan
-    // and the animation come as files.
-    const links = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-1")
-      .flatMap((tr) => [...tr.querySelectorAll("a")].map((a) => a.href)));
-    if (links.length !== 3) problems.push("dash-1 links to " + links.length + " results, not 3");
-    for (const link of links.filter((l) => !l.endsWith(".html"))) {
-      const status = await page.evaluate(async (l) => (await fetch(l)).status, link);
-      if (status !== 200) problems.push(link + ": HTTP " + status);
-    }
-    const report = await browser.newPage();
-    report.on("console", (m) => { if (m.type() === "error") problems.push("report: console error: " + m.text()); });
-    report.on("pageerror", (e) => problems.push("report: page error: " + e.message));
-    const opened = await report.goto(links.find((l) => l.endsWith("report.html")) || origin + "/none", { waitUntil: "load" });
-    if (!opened || opened.status() !== 200) problems.push("the report did not open: HTTP " + (opened && opened.status()));
-    await report.waitForFunction(() => document.body.dataset.viewer, { timeout: 45000 })
-      .then(async () => {
-        const viewer = await report.evaluate(() => document.body.dataset.viewer);
-        if (viewer !== "ready") problems.push("the report's 3D view did not start: " + viewer);
-      })
-      .catch(() => problems.push("the report's 3D view never said whether it started"));
-    await report.close();
-    const bars = await page.evaluate(() => window.dashboard.bars.filter((b) => b.order === "dash-1").length);
-    if (bars < 5) problems.push("the Gantt chart holds " + bars + " bars of dash-1's work");
-
-    // A killed buffer: gone, then back.
-    const buffer = ids.find((id) => id.startsWith("buffer"));
-    const pid = processOf(buffer);
-    if (!pid) {
-      problems.push("no process of " + buffer + " found");
-    } else {
-      process.kill(pid, "SIGKILL");
-      await page.waitForFunction((id) => {
-        const seen = window.dashboard.seen[id] || [];
-        const gone = seen.lastIndexOf("gone");
-        return gone >= 0 && seen.slice(gone + 1).some((s) => s !== "gone");
-      }, { timeout: 60000 }, buffer).catch(async () => problems.push(
-        buffer + " did not turn gone and back: it went " + JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], buffer))));
-      const alarms = await page.$$eval("#alarms li", (lis) => lis.map((li) => li.textContent));
-      if (!alarms.some((a) => a.includes(buffer) && a.includes("restarted"))) problems.push("no alarm says " + buffer + " restarted");
-    }
-    // The operator cancels an order from its row (the page asks first): it fails with the reason.
-    const again = await upload(productZip, "dash-c");
-    if (again.cls !== "answer-ok") problems.push("the product's zip was not taken again: " + JSON.stringify(again));
-    const cancel = await page.waitForFunction(() => {
-      const row = [...document.querySelectorAll("#orders tbody tr")].find((tr) => tr.cells[0].textContent === "dash-c");
-      return row && row.querySelector("button.cancel");
-    }, { timeout: 20000 }).catch(() => null);
-    if (!cancel) {
-      problems.push("dash-c has no cancel button");
-    } else {
-      // The page's script stands still while its question is open: the wait begins once it is answered.
-      const asked = new Promise((resolve) => page.once("dialog", (d) => d.accept().then(resolve, resolve)));
-      await cancel.asElement().click();
-      await asked;
-      await shows("dash-c", "FAILED").catch((e) => problems.push("dash-c, cancelled, never showed FAILED: " + e.message));
-      const reason = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-c")
-        .map((tr) => tr.cells[5].textContent).join(""));
-      if (!reason.startsWith("cancelled by the operator (dashboard)")) problems.push("dash-c failed for another reason: " + reason);
-    }
-    // The operator takes the robot out of service from its row (the page asks why), and back.
-    const robot = ids.find((id) => id.startsWith("mobile-robot"));
-    const serviceButton = (id, text) => page.waitForFunction((id, text) => {
-      const row = [...document.querySelectorAll("#resources tbody tr")].find((tr) => tr.cells[0].textContent === id);
-      return row && [...row.querySelectorAll("button.service")].find((b) => b.textContent === text);
-    }, { timeout: 20000 }, id, text).catch(() => null);
-    const out = await serviceButton(robot, "out of service");
-    if (!out) {
-      problems.push(robot + " has no out-of-service button");
-    } else {
-      const asked = new Promise((resolve) => page.once("dialog", (d) => d.accept("wheel check").then(resolve, resolve)));
-      await out.asElement().click();
-      await asked;
-      const back = await serviceButton(robot, "back into service");
-      const state = await page.$$eval("#resources tbody tr", (rows, id) => rows.filter((tr) => tr.cells[0].textContent === id)
-        .map((tr) => tr.cells[2].textContent + " | " + tr.cells[2].firstChild.title).join(""), robot);
-      if (!back || !state.startsWith("out of service | wheel check (the operator (dashboard))")) {
-        problems.push(robot + " did not show out of service with the reason: " + state);
+      step = "uploading";
+      // The page's form: a file that is not a zip is refused, with the reason shown; the
+      // product's zip becomes order dash-1.
+      const upload = async (file, id) => {
+        await page.evaluate(() => { document.getElementById("submit-answer").textContent = ""; });
+        await (await page.$("#submit-file")).uploadFile(file);
+        await page.$eval("#submit-id", (input, id) => { input.value = id; }, id);
+        await page.click("#submit-button");
+        await page.waitForFunction(() => /order|zip|archive|refused|larger|cell/.test(document.getElementById("submit-answer").textContent)
+          && !document.getElementById("submit-button").disabled, { timeout: 30000 });
+        return page.$eval("#submit-answer", (o) => ({ text: o.textContent, cls: o.className }));
+      };
+      refusing = true;
+      const refused = await upload(product, "dash-0");
+      refusing = false;
+      if (refused.cls !== "answer-refused" || !refused.text.includes("not a zip archive")) {
+        problems.push("an .aml sent as the product's zip was not refused with the reason: " + JSON.stringify(refused));
       }
-      if (back) {
-        await back.asElement().click();
-        await page.waitForFunction((id) => (window.dashboard.seen[id] || []).slice(-1)[0] !== "out of service", { timeout: 20000 }, robot)
-          .catch(async () => problems.push(robot + " did not come back into service: it went " +
-                                           JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], robot))));
+      const taken = await upload(productZip, "dash-1");
+      if (taken.cls !== "answer-ok" || !taken.text.includes("dash-1")) problems.push("the product's zip was not taken: " + JSON.stringify(taken));
+      // DASHBOARD_ORDERS more, by cellctl, for a measurement of the latency while the cell is busy.
+      const extra = Number(process.env.DASHBOARD_ORDERS || 0);
+      const submits = [];
+      for (let i = 2; i <= 1 + extra; ++i) {
+        submits.push(spawn(cellctl, ["submit", product, "--domain", domain, "--order", "dash-" + i, "--out",
+                                     path.join(scratch, "dash-" + i), "--detach"], { stdio: "ignore" }));
       }
-    }
-    const drawn = await page.evaluate(() => document.body.dataset.scene);
-    if (drawn !== "drawn") problems.push("the 3D view was not drawn");
+      const shows = (order, state) => page.waitForFunction((order, state) => [...document.querySelectorAll("#orders tbody tr")].some(
+        (tr) => tr.cells[0].textContent === order && tr.cells[1].textContent === state), { timeout: 150000 + 20000 * extra }, order, state);
+      if (screenshot) {  // the page at work
+        await shows("dash-1", "PHYSICAL_ASSEMBLY").then(() => sleep(800)).then(() => page.screenshot({ path: screenshot, fullPage: true }))
+          .catch(() => console.log("no screenshot: dash-1 was not seen in PHYSICAL_ASSEMBLY"));
+      }
+      step = "waiting for the orders to be done";
+      for (let i = 1; i <= 1 + extra; ++i) {
+        await shows("dash-" + i, "DONE").catch(() => problems.push("order dash-" + i + " never showed DONE"));
+      }
+      submits.forEach((s) => s.kill("SIGTERM"));
+      step = "opening dash-1's results";
+      // Its results, from the page's links: the report opens (sandboxed) with no error, the plan
+      // and the animation come as files.
+      const links = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-1")
+        .flatMap((tr) => [...tr.querySelectorAll("a")].map((a) => a.href)));
+      if (links.length !== 3) problems.push("dash-1 links to " + links.length + " results, not 3");
+      for (const link of links.filter((l) => !l.endsWith(".html"))) {
+        const status = await page.evaluate(async (l) => (await fetch(l)).status, link);
+        if (status !== 200) problems.push(link + ": HTTP " + status);
+      }
+      const report = await browser.newPage();
+      report.on("console", (m) => { if (m.type() === "error") problems.push("report: console error: " + m.text()); });
+      report.on("pageerror", (e) => problems.push("report: page error: " + e.message));
+      const opened = await report.goto(links.find((l) => l.endsWith("report.html")) || origin + "/none", { waitUntil: "load" });
+      if (!opened || opened.status() !== 200) problems.push("the report did not open: HTTP " + (opened && opened.status()));
+      await report.waitForFunction(() => document.body.dataset.viewer, { timeout: 45000 })
+        .then(async () => {
+          const viewer = await report.evaluate(() => document.body.dataset.viewer);
+          if (viewer !== "ready") problems.push("the report's 3D view did not start: " + viewer);
+        })
+        .catch(() => problems.push("the report's 3D view never said whether it started"));
+      await report.close();
+      const bars = await page.evaluate(() => window.dashboard.bars.filter((b) => b.order === "dash-1").length);
+      if (bars < 5) problems.push("the Gantt chart holds " + bars + " bars of dash-1's work");
 
-    const [latencies, built, received] = await page.evaluate(
-      () => [window.dashboard.latencies, window.dashboard.built, window.dashboard.received]);
-    const ms = (values, p) => (1000 * percentile(values, p)).toFixed(1);
-    if (latencies.length) {
-      console.log("update latency, DDS event heard to page drawn: p50 " + ms(latencies, 0.5) + " ms, p99 " + ms(latencies, 0.99) +
-                  " ms over " + latencies.length + " updates; to the state built: p50 " + ms(built, 0.5) +
-                  " ms, p99 " + ms(built, 0.99) + " ms; to the page's script: p50 " + ms(received, 0.5) + " ms, p99 " +
-                  ms(received, 0.99) + " ms");
-    } else {
-      problems.push("no update reached the page");
-    }
+      step = "killing a buffer";
+      // A killed buffer: gone, then back.
+      const buffer = ids.find((id) => id.startsWith("buffer"));
+      const pid = processOf(buffer);
+      if (!pid) {
+        problems.push("no process of " + buffer + " found");
+      } else {
+        process.kill(pid, "SIGKILL");
+        await page.waitForFunction((id) => {
+          const seen = window.dashboard.seen[id] || [];
+          const gone = seen.lastIndexOf("gone");
+          return gone >= 0 && seen.slice(gone + 1).some((s) => s !== "gone");
+        }, { timeout: 60000 }, buffer).catch(async () => problems.push(
+          buffer + " did not turn gone and back: it went " + JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], buffer))));
+        const alarms = await page.$$eval("#alarms li", (lis) => lis.map((li) => li.textContent));
+        if (!alarms.some((a) => a.includes(buffer) && a.includes("restarted"))) problems.push("no alarm says " + buffer + " restarted");
+      }
+      step = "cancelling dash-c";
+      // The operator cancels an order from its row (the page asks first): it fails with the reason.
+      const again = await upload(productZip, "dash-c");
+      if (again.cls !== "answer-ok") problems.push("the product's zip was not taken again: " + JSON.stringify(again));
+      if (!(await clickInRow(page, "orders", "dash-c", "button.cancel", true))) {
+        problems.push("dash-c has no cancel button, or its click asked nothing");
+      } else {
+        await shows("dash-c", "FAILED").catch((e) => problems.push("dash-c, cancelled, never showed FAILED: " + e.message));
+        const reason = await page.$$eval("#orders tbody tr", (rows) => rows.filter((tr) => tr.cells[0].textContent === "dash-c")
+          .map((tr) => tr.cells[5].textContent).join(""));
+        if (!reason.startsWith("cancelled by the operator (dashboard)")) problems.push("dash-c failed for another reason: " + reason);
+      }
+      // The operator takes the robot out of service from its row (the page asks why), and back.
+      const robot = ids.find((id) => id.startsWith("mobile-robot"));
+      step = "taking " + robot + " out of service";
+      if (!(await clickInRow(page, "resources", robot, "button.service", "wheel check", "out of service"))) {
+        problems.push(robot + " has no out-of-service button, or its click asked nothing");
+      } else {
+        await page.waitForFunction((id) => (window.dashboard.seen[id] || []).slice(-1)[0] === "out of service", { timeout: 20000 }, robot)
+          .catch(() => {});
+        const state = await page.$$eval("#resources tbody tr", (rows, id) => rows.filter((tr) => tr.cells[0].textContent === id)
+          .map((tr) => tr.cells[2].textContent + " | " + tr.cells[2].firstChild.title).join(""), robot);
+        if (!state.startsWith("out of service | wheel check (the operator (dashboard))")) {
+          problems.push(robot + " did not show out of service with the reason: " + state);
+        }
+        step = "bringing " + robot + " back into service";
+        if (!(await clickInRow(page, "resources", robot, "button.service", null, "back into service"))) {
+          problems.push(robot + " has no back-into-service button");
+        } else {
+          await page.waitForFunction((id) => (window.dashboard.seen[id] || []).slice(-1)[0] !== "out of service", { timeout: 20000 }, robot)
+            .catch(async () => problems.push(robot + " did not come back into service: it went " +
+                                             JSON.stringify(await page.evaluate((id) => window.dashboard.seen[id], robot))));
+        }
+      }
+      const drawn = await page.evaluate(() => document.body.dataset.scene);
+      if (drawn !== "drawn") problems.push("the 3D view was not drawn");
+
+      const [latencies, built, received] = await page.evaluate(
+        () => [window.dashboard.latencies, window.dashboard.built, window.dashboard.received]);
+      const ms = (values, p) => (1000 * percentile(values, p)).toFixed(1);
+      if (latencies.length) {
+        console.log("update latency, DDS event heard to page drawn: p50 " + ms(latencies, 0.5) + " ms, p99 " + ms(latencies, 0.99) +
+                    " ms over " + latencies.length + " updates; to the state built: p50 " + ms(built, 0.5) +
+                    " ms, p99 " + ms(built, 0.99) + " ms; to the page's script: p50 " + ms(received, 0.5) + " ms, p99 " +
+                    ms(received, 0.99) + " ms");
+      } else {
+        problems.push("no update reached the page");
+      }
+    })()]);
   } catch (e) {
     problems.push(e.message);
   } finally {
