@@ -379,7 +379,7 @@ int submit_to_desk(const CellConfig& cell, const SubmitOptions& o, const Order& 
 
 // The dashboard, its address printed and its token kept beside the cell's state (0600) for
 // the operator who did not see the print.
-std::unique_ptr<Dashboard> open_dashboard(const DashboardAddress& at, const CellConfig& cell, const CellObserver& observer) {
+std::unique_ptr<Dashboard> open_dashboard(const DashboardAddress& at, const CellConfig& cell, CellObserver& observer) {
   auto page = std::make_unique<Dashboard>(at, cell, observer);
   const fs::path token_file = cell.state_folder() / "dashboard.token";
   fs::create_directories(cell.state_folder());

@@ -19,7 +19,7 @@ std::string event(const char* name, const std::string& data) {
 }  // namespace
 
 struct Dashboard::Impl {
-  Impl(const CellConfig& cell, const CellObserver& observer) : routes(cell, new_token()), feed(cell, observer) {}
+  Impl(const CellConfig& cell, CellObserver& observer) : routes(cell, new_token()), feed(cell, observer) {}
 
   DashboardRoutes routes;
   DashboardFeed feed;
@@ -62,7 +62,7 @@ struct Dashboard::Impl {
   }
 };
 
-Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, const CellObserver& observer)
+Dashboard::Dashboard(const DashboardAddress& address, const CellConfig& cell, CellObserver& observer)
     : impl_(std::make_unique<Impl>(cell, observer)) {
   Impl& d = *impl_;
   d.host = address.host;

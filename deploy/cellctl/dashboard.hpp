@@ -32,7 +32,7 @@ class Dashboard {
   static constexpr std::chrono::seconds kReadTimeout{2};
 
   // Listens at once; throws with the reason when it cannot (the port is taken).
-  Dashboard(const DashboardAddress& address, const CellConfig& cell, const CellObserver& observer);
+  Dashboard(const DashboardAddress& address, const CellConfig& cell, CellObserver& observer);
   ~Dashboard();
   Dashboard(const Dashboard&) = delete;
   Dashboard& operator=(const Dashboard&) = delete;

@@ -6,6 +6,8 @@
 
 #include "deploy/cellctl/cell_status.hpp"
 #include "services/dds/conversions.hpp"
+#include "services/dds/endpoints.hpp"
+#include "simulationPubSubTypes.h"
 
 namespace cellctl {
 namespace {
@@ -28,8 +30,23 @@ bool is_alarm(const state::JournalEntry& e) {
 
 }  // namespace
 
-DashboardFeed::DashboardFeed(const CellConfig& cell, const CellObserver& observer)
-    : cell_(cell), observer_(observer), thread_([this] { run(); }) {}
+struct DashboardFeed::SceneReaders {
+  dds::Reader<cell::SimRequest, cell::SimRequestPubSubType> requests;
+  dds::Reader<cell::SimReply, cell::SimReplyPubSubType> replies;
+};
+
+DashboardFeed::DashboardFeed(const CellConfig& cell, CellObserver& observer)
+    : cell_(cell), observer_(observer), thread_([this] { run(); }) {
+  // Twins' virtual assemblies make most of these: they are read and left (PhysicalScene).
+  scene_readers_.reset(new SceneReaders{
+      {observer.participant(), "cell/sim/requests", dds::TopicKind::events,
+       [this](const cell::SimRequest& r) {
+         if (scene_.take(r, observer_.sim_now())) observer_.note_change();
+       }},
+      {observer.participant(), "cell/sim/replies", dds::TopicKind::events, [this](const cell::SimReply& r) {
+         if (scene_.take(r)) observer_.note_change();
+       }}});
+}
 
 DashboardFeed::~DashboardFeed() { stop(); }
 
@@ -205,6 +222,7 @@ void DashboardFeed::build() {
   status["bars"] = bar_seq_;
   status["domain"] = cell_.domain;
   status["real_time_factor"] = cell_.real_time_factor;
+  status["bodies"] = scene_.bodies(observer_.sim_now());
 
   std::string content = status.dump();
   if (content == last_content_) return;

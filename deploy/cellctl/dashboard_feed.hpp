@@ -3,7 +3,8 @@
 // `cellctl status`'s view (resources, orders, inventory) with each resource's command under
 // way, what needs attention first, the alarms (the journal's restarts, hangs, inspections and
 // failed orders; refused and aborted commands, whose and why) and the commands done, as the
-// bars of a Gantt chart.
+// bars of a Gantt chart, and the physical cell (PhysicalScene, from cell-sim's requests and
+// replies).
 //
 // A thread of its own builds the state when the observer hears a change (at most one build
 // per kMinGap: a busy cell costs a bounded share of a core) and every kRefresh for what only
@@ -26,6 +27,7 @@
 #include "deploy/cellctl/cell_config.hpp"
 #include "deploy/cellctl/cell_observer.hpp"
 #include "deploy/cellctl/command_bars.hpp"
+#include "deploy/cellctl/physical_scene.hpp"
 #include "services/state/cell_store.hpp"
 
 namespace cellctl {
@@ -38,7 +40,9 @@ class DashboardFeed {
   static constexpr std::size_t kKeptBars = 20000;
   static constexpr double kBarsWindow = 3600;  // sim s of bars kept
 
-  DashboardFeed(const CellConfig& cell, const CellObserver& observer);
+  // Follows cell-sim's requests and replies on the observer's participant, and tells the
+  // observer when the physical scene changed.
+  DashboardFeed(const CellConfig& cell, CellObserver& observer);
   ~DashboardFeed();
   DashboardFeed(const DashboardFeed&) = delete;
   DashboardFeed& operator=(const DashboardFeed&) = delete;
@@ -62,7 +66,7 @@ class DashboardFeed {
   nlohmann::json attention(const nlohmann::json& status) const;
 
   const CellConfig& cell_;
-  const CellObserver& observer_;
+  CellObserver& observer_;
   std::unique_ptr<state::CellStore> store_;  // opened once the cell's database exists
   // The build thread's own.
   std::uint64_t events_seen_ = 0;
@@ -83,6 +87,9 @@ class DashboardFeed {
   std::deque<std::pair<std::uint64_t, std::string>> bars_;
   std::deque<double> bar_ends_;  // sim s, beside bars_
   std::uint64_t bar_seq_ = 0;
+  PhysicalScene scene_;
+  struct SceneReaders;
+  std::unique_ptr<SceneReaders> scene_readers_;  // after scene_: they end before it
   std::thread thread_;
 };
 

@@ -105,8 +105,10 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
                                  "cell/orders/twins", "cell/command_events"} + kEveryone;
   // Both start twins (cellctl run; cellctl up's desk) and bind them to their orders.
   grants.push_back({"cellctl", "cellctl", {}, {"cell/orders/twins", "cell/roster"}, observer});
-  // cellctl up: it observes the cell and runs the order desk of every client.
-  Grant desk{"order-desk", "order-desk", {}, {"cell/orders/twins", "cell/roster"}, observer};
+  // cellctl up: it observes the cell, runs the order desk of every client, and its dashboard
+  // follows cell-sim's requests and replies (the robots' moves, the parts placed).
+  Grant desk{"order-desk", "order-desk", {}, {"cell/orders/twins", "cell/roster"},
+             observer + Topics{"cell/sim/requests", "cell/sim/replies"}};
   for (const auto& c : cell.clients) {
     desk.publish = desk.publish + Topics{desk_topic("replies", c), desk_topic("results", c)};
     desk.subscribe = desk.subscribe + Topics{desk_topic("files", c), desk_topic("orders", c)};

@@ -181,6 +181,11 @@ function percentile(values, p) {
         })
         .catch(() => problems.push("the report's 3D view never said whether it started"));
       await report.close();
+      // The 3D view: the robot and the arm seen moving, dash-1's parts in the cell.
+      const [frames, parts] = await page.evaluate(() => [window.dashboard.movingFrames, window.dashboard.parts["dash-1"] || 0]);
+      console.log("3D view: " + frames + " frames drawn while something moved; at most " + parts + " parts of dash-1 in the cell at once");
+      if (!frames) problems.push("the 3D view never showed anything moving");
+      if (parts < 2) problems.push("the 3D view showed " + parts + " parts of dash-1");
       const bars = await page.evaluate(() => window.dashboard.bars.filter((b) => b.order === "dash-1").length);
       if (bars < 5) problems.push("the Gantt chart holds " + bars + " bars of dash-1's work");
 

@@ -11,9 +11,12 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <regex>
 #include <set>
 
 #include <catch2/catch.hpp>
+#include <httplib.h>
+#include <nlohmann/json.hpp>
 
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
@@ -168,11 +171,12 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
   REQUIRE(test::cellctl({"pki", "issue", stale.string(), "buffer-2", "--domain", domain, "--days", "1", "--backdate-days", "2"},
                         dir / "stale.log") == 0);
 
-  // Security on by the deployment file's key (a folder relative to the file).
+  // Security on by the deployment file's key (a folder relative to the file); the dashboard
+  // follows cell-sim's requests and replies under the desk's permissions.
   const fs::path cell = dir / "cell.yaml";
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nsecurity: pki\n";
   test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "50",
-                         "--state-dir", (dir / "state").string()},
+                         "--state-dir", (dir / "state").string(), "--dashboard", "127.0.0.1:0"},
                         (dir / "up.log").string());
   const auto up_log = [&] { return test::read_text(dir / "up.log"); };
 
@@ -403,6 +407,21 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
                                   dir / "after.log");
   INFO(test::read_text(dir / "after.log") << up_log());
   CHECK(order == 0);
+  {  // The dashboard read cell-sim's requests under the desk's permissions: the cell's bodies.
+    const std::string log = up_log();
+    std::smatch m;
+    REQUIRE(std::regex_search(log, m, std::regex("dashboard: http://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
+    httplib::Client client("127.0.0.1", std::stoi(m[1]));
+    const auto state = client.Get("/state", {{"Authorization", "Bearer " + m[2].str()}});
+    REQUIRE(state);
+    const nlohmann::json bodies = nlohmann::json::parse(state->body)["bodies"];
+    std::set<std::string> owners;
+    for (const auto& b : bodies) owners.insert(b["owner"].get<std::string>());
+    INFO(bodies.dump());
+    CHECK(owners.count("mobile-robot-1"));
+    CHECK(owners.count("station-1"));
+    CHECK(owners.count("arm-1"));
+  }
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }

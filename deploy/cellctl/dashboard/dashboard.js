@@ -3,7 +3,8 @@
 "use strict";
 (function () {
   // What the page saw, for whoever checks it: each resource's states in turn ("idle", "gone"...).
-  const page = (window.dashboard = { states: 0, latencies: [], built: [], received: [], bars: [], state: null, seen: {} });
+  const page = (window.dashboard = { states: 0, latencies: [], built: [], received: [], bars: [], state: null, seen: {},
+                                     movingFrames: 0, parts: {} });
   let receivedAt = 0; // wall s when the last state came
   let lastHeard = 0;
 
@@ -186,36 +187,113 @@
     "mobile-robot": () => new THREE.CylinderGeometry(0.25, 0.25, 0.3, 24),
     arm: () => new THREE.CylinderGeometry(0.05, 0.07, 0.5, 12),
   };
-  function renderScene(resources) {
+  // Where a body is at sim time t: along the segment of its move it is on (docs/dashboard.md).
+  function poseAt(b, t) {
+    const m = b.motion;
+    let from = b.pose, to = b.pose, f = 0;
+    if (m && t < m.t[m.t.length - 1]) {
+      let i = 1;
+      while (i < m.t.length - 1 && t >= m.t[i]) ++i;
+      from = m.poses[i - 1];
+      to = m.poses[i];
+      f = t <= m.t[i - 1] ? 0 : (t - m.t[i - 1]) / (m.t[i] - m.t[i - 1]);
+    }
+    const q = new THREE.Quaternion(from[4], from[5], from[6], from[3]);
+    q.slerp(new THREE.Quaternion(to[4], to[5], to[6], to[3]), f);
+    const p = new THREE.Vector3(from[0], from[1], from[2]).lerp(new THREE.Vector3(to[0], to[1], to[2]), f);
+    return { p, q };
+  }
+  function meshOf(id, make) {
+    let mesh = scene.meshes.get(id);
+    if (!mesh) {
+      mesh = new THREE.Mesh(make(), new THREE.MeshLambertMaterial());
+      scene.meshes.set(id, mesh);
+      scene.three.add(mesh);
+    }
+    mesh.userData.drawn = true;
+    return mesh;
+  }
+  // The resources where their capabilities place them, and the bodies of the physical cell
+  // where cell-sim has them: a mobile robot where its base is, the tables and grippers as
+  // their boxes, each part as a small cube in its order's colour (its mesh stays in the cell).
+  function renderScene(s, t) {
     if (!scene.ready) return;
-    // Software rendering takes tens of ms: only when something in the view changed.
-    const key = JSON.stringify(resources.map((r) => [r.id, r.alive, r.busy, r.out_of_service, r.position]));
-    if (key === scene.key) return;
-    scene.key = key;
-    for (const r of resources) {
-      if (!r.position || !shapes[r.kind]) continue;
-      let mesh = scene.meshes.get(r.id);
-      if (!mesh) {
-        mesh = new THREE.Mesh(shapes[r.kind](), new THREE.MeshLambertMaterial());
-        scene.meshes.set(r.id, mesh);
-        scene.three.add(mesh);
+    for (const mesh of scene.meshes.values()) mesh.userData.drawn = false;
+    const bases = new Map();
+    const parts = {};  // order -> its parts in the cell
+    for (const b of s.bodies || []) {
+      if (b.mesh) parts[b.order] = (parts[b.order] || 0) + 1;
+      const size = b.half_extents;
+      if (!b.mesh && size.every((h) => h === 0)) {
+        if (b.owner) bases.set(b.owner, b);
+        continue;
       }
+      const { p, q } = poseAt(b, t);
+      const mesh = b.mesh ? meshOf("body:" + b.id, () => new THREE.BoxGeometry(0.04, 0.04, 0.04))
+                          : meshOf("body:" + b.id, () => new THREE.BoxGeometry(2 * size[0], 2 * size[1], 2 * size[2]));
+      mesh.position.copy(p);
+      mesh.quaternion.copy(q);
+      mesh.material.color.set(b.mesh ? "hsl(" + hue(b.order) + ", 65%, 45%)" : b.owner.startsWith("station") ? 0xb8c0c8 : 0x455a64);
+    }
+    for (const [order, n] of Object.entries(parts)) page.parts[order] = Math.max(page.parts[order] || 0, n);
+    if (!scene.framed) frame(s.resources.filter((r) => r.position).map((r) => new THREE.Vector3(...r.position)));
+    for (const r of s.resources) {
+      if (!r.position || !shapes[r.kind]) continue;
+      const mesh = meshOf(r.id, shapes[r.kind]);
       const lift = r.kind === "arm" ? 0.25 : r.kind === "station" ? -0.025 : 0.15;
-      mesh.position.set(r.position[0], r.position[1] + lift, r.position[2]);
+      const base = bases.get(r.id);
+      const at = base ? poseAt(base, t).p : new THREE.Vector3(...r.position);
+      mesh.position.set(at.x, at.y + lift, at.z);
       mesh.material.color.set(!r.alive ? 0xb00020 : r.out_of_service ? 0x5f6368 : r.busy ? 0x0b5cad : r.kind === "station" ? 0x9aa5b1 : 0x2e7d32);
+    }
+    for (const [id, mesh] of scene.meshes) {
+      if (mesh.userData.drawn) continue;
+      scene.three.remove(mesh);
+      mesh.geometry.dispose();
+      mesh.material.dispose();
+      scene.meshes.delete(id);
     }
     scene.renderer.render(scene.three, scene.camera);
     document.body.dataset.scene = "drawn";
   }
+  // The camera takes in the whole cell, from above and in front, once it knows where it is.
+  function frame(places) {
+    if (!places.length) return;
+    const box = new THREE.Box3().setFromPoints(places);
+    const centre = box.getCenter(new THREE.Vector3());
+    const reach = Math.max(1, box.getSize(new THREE.Vector3()).length() / 2);
+    scene.camera.position.set(centre.x + 1.1 * reach, centre.y + 1.6 * reach, centre.z + 2.0 * reach);
+    scene.camera.lookAt(centre);
+    scene.framed = true;
+  }
+  // Drawn when the view changed, and while something moves, at most ten times a second
+  // (software rendering takes tens of ms a frame).
+  function drawScene() {
+    const s = page.state;
+    if (!scene.ready || !s || scene.nextFrame) return;
+    const again = () => { scene.nextFrame = setTimeout(() => { scene.nextFrame = null; drawScene(); }, 100); };
+    if (Date.now() - (scene.drawnAt || 0) < 100) return again();
+    const t = simNow();
+    const moving = (s.bodies || []).some((b) => b.motion && t < b.motion.t[b.motion.t.length - 1]);
+    const key = JSON.stringify([s.resources.map((r) => [r.id, r.alive, r.busy, r.out_of_service, r.position]), s.bodies]);
+    if (key === scene.key && !moving && !scene.wasMoving) return;
+    scene.key = key;
+    scene.wasMoving = moving;
+    scene.drawnAt = Date.now();
+    renderScene(s, t);
+    if (moving) {
+      page.movingFrames += 1;
+      again();
+    }
+  }
 
-  // The tables at once; the chart and the 3D view, which take longer to draw, at most every
-  // quarter of a second (the newest state then).
+  // The tables at once, the 3D view at most ten times a second (drawScene), the chart, which
+  // takes longer to draw, at most every quarter of a second (the newest state then).
   let slowDrawn = 0, slowPending = false;
   function drawSlow() {
     slowPending = false;
     slowDrawn = Date.now();
     renderGantt();
-    renderScene(page.state.resources);
   }
   function render(s) {
     document.getElementById("domain").textContent = "on domain " + s.domain;
@@ -224,6 +302,7 @@
     renderOrders(s.orders);
     renderInventory(s.inventory);
     renderAlarms(s.alarms);
+    drawScene();
     if (slowPending) return;
     slowPending = true;
     setTimeout(drawSlow, Math.max(0, slowDrawn + 250 - Date.now()));
