@@ -211,7 +211,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
               "setup_cost", "currency", "standby_twins", "max_twins", "twin_identities", "fixtures", "discovery",
-              "dashboard"});
+              "dashboard", "operators"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
   read(file, root, "liveliness_lease", c.liveliness_lease);
@@ -268,9 +268,13 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   read(file, root, "currency", c.currency);
   if (c.currency.empty() || c.currency.size() > 8) throw ConfigError(where(file, root["currency"]) + ": currency is 1 to 8 characters");
   read(file, root, "clients", c.clients);
-  for (const auto& id : c.clients) {
-    if (id.empty() || id.size() > 64 || id.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos) {
-      throw ConfigError(where(file, root["clients"]) + ": a client id is 1 to 64 of a-z, 0-9, - and _ ('" + id + "' is not)");
+  read(file, root, "operators", c.operators);
+  for (const char* key : {"clients", "operators"}) {
+    for (const auto& id : std::string(key) == "clients" ? c.clients : c.operators) {
+      if (id.empty() || id.size() > 64 || id.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos) {
+        throw ConfigError(where(file, root[key]) + ": a name in " + key + " is 1 to 64 of a-z, 0-9, - and _ ('" + id +
+                          "' is not)");
+      }
     }
   }
   if (const YAML::Node desk = root["desk"]) {
@@ -329,12 +333,14 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     if (!ids.insert(id).second) throw ConfigError(where(file, node) + ": a second resource is called '" + id + "'");
     if (is_twin_identity(id)) throw ConfigError(where(file, node) + ": '" + id + "' is the name of a twin's identity");
   }
-  // A client's id names its DDS-Security identity too: none may be another's.
-  ids.insert({"cell-sim", "twin", "cellctl", "order-desk"});
-  for (const auto& id : c.clients) {
-    if (!ids.insert(id).second || is_twin_identity(id)) {
-      throw ConfigError(where(file, root["clients"]) + ": the client '" + id + "' has the name of a resource, of another client or of " +
-                        "cell-sim, twin, twin-N, cellctl or order-desk");
+  // A client's and an operator's name is their DDS-Security identity too: none may be another's.
+  ids.insert({"cell-sim", "twin", "cellctl", "order-desk", "dashboard", "discovery"});
+  for (const char* key : {"clients", "operators"}) {
+    for (const auto& id : std::string(key) == "clients" ? c.clients : c.operators) {
+      if (!ids.insert(id).second || is_twin_identity(id)) {
+        throw ConfigError(where(file, root[key]) + ": '" + id + "' of " + key + " has the name of a resource, of another " +
+                          "client or operator, or of cell-sim, twin, twin-N, cellctl, order-desk, dashboard or discovery");
+      }
     }
   }
   for (std::size_t i = 0; i < c.stations.size(); ++i) {

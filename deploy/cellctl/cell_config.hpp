@@ -105,6 +105,9 @@ struct CellConfig {
   std::filesystem::path security_dir;
   // `clients: [oem-a, oem-b]`: who may submit over DDS (the order desk's topics per client).
   std::vector<std::string> clients;
+  // `operators: [alice]`: with security, who may use the dashboard by a client certificate of
+  // the cell's CA (`cellctl pki` issues one per name), besides the token.
+  std::vector<std::string> operators;
   DeskLimits desk;
   // What a quote charges (docs/quotes.md): `setup_cost:` per order, plus each resource's
   // `cost_per_hour:` for the time the order uses it, in `currency:`.

@@ -36,7 +36,13 @@ struct DashboardFeed::SceneReaders {
 };
 
 DashboardFeed::DashboardFeed(const CellConfig& cell, CellObserver& observer)
-    : cell_(cell), observer_(observer), thread_([this] { run(); }) {
+    : cell_(cell),
+      observer_(observer),
+      scene_([&cell] {
+        const auto ids = cell.resource_ids();
+        return std::set<std::string>(ids.begin(), ids.end());
+      }()),
+      thread_([this] { run(); }) {
   // Twins' virtual assemblies make most of these: they are read and left (PhysicalScene).
   scene_readers_.reset(new SceneReaders{
       {observer.participant(), "cell/sim/requests", dds::TopicKind::events,

@@ -1,6 +1,8 @@
 #include "deploy/cellctl/dashboard_routes.hpp"
 
 #include <openssl/crypto.h>
+#include <openssl/ssl.h>
+#include <openssl/x509.h>
 
 #include <filesystem>
 #include <fstream>
@@ -41,11 +43,32 @@ std::string token_of(const httplib::Request& req) {
 
 std::string new_token() { return random_hex(24); }
 
+std::string DashboardRoutes::operator_of(const httplib::Request& req) const {
+  if (!req.ssl || SSL_get_verify_result(req.ssl) != X509_V_OK) return "";
+  X509* peer = SSL_get0_peer_certificate(req.ssl);
+  if (!peer) return "";
+  char name[256] = {};
+  if (X509_NAME_get_text_by_NID(X509_get_subject_name(peer), NID_commonName, name, sizeof name) <= 0) return "";
+  for (const auto& o : cell_.operators) {
+    if (o == name) return o;
+  }
+  return "";
+}
+
+std::string DashboardRoutes::who(const httplib::Request& req) const {
+  const std::string name = operator_of(req);
+  return name.empty() ? "the operator (dashboard)" : "operator " + name + " (dashboard)";
+}
+
 bool DashboardRoutes::allowed(const httplib::Request& req, httplib::Response& res) const {
-  if (same(token_of(req), token_)) return true;
+  if (same(token_of(req), token_) || !operator_of(req).empty()) return true;
   res.status = 401;
   res.set_content("This cell's dashboard needs the operator token that cellctl up printed: open the address it gave, "
-                  "with ?token=...\n",
+                  "with ?token=..." +
+                      std::string(cell_.security_dir.empty() ? ""
+                                                             : "; or a certificate of the cell's CA of one of its operators "
+                                                               "(the deployment file's operators:, `cellctl pki issue`)") +
+                      "\n",
                   "text/plain");
   return false;
 }
@@ -121,7 +144,7 @@ httplib::Server::HandlerResponse DashboardRoutes::before_body(const httplib::Req
   // A page of another site may post here with the operator's cookie no more than read (the
   // cookie is SameSite=Strict); a browser names the page's origin, and it must be this one.
   const std::string origin = req.get_header_value("Origin");
-  if (!origin.empty() && origin != "http://" + req.get_header_value("Host")) {
+  if (!origin.empty() && origin != (req.ssl ? "https://" : "http://") + req.get_header_value("Host")) {
     res.status = 403;
     res.set_content("an action on this cell comes from its own dashboard only\n", "text/plain");
     return Handled::Handled;
@@ -196,7 +219,7 @@ void DashboardRoutes::install(httplib::Server& s) {
   s.Post(R"(/orders/([A-Za-z0-9_.-]{1,128})/cancel)", [this](const httplib::Request& req, httplib::Response& res) {
     const std::string order = req.matches[1];
     state::CellStore store(cell_.state_folder());
-    const ActionAnswer answer = cancel_order(store, order, "the operator (dashboard)");
+    const ActionAnswer answer = cancel_order(store, order, who(req));
     res.status = answer.status;
     res.set_content(nlohmann::json{{"order", order}, {"message", answer.message}}.dump(), "application/json");
   });
@@ -208,7 +231,7 @@ void DashboardRoutes::install(httplib::Server& s) {
            ActionAnswer answer{400, "say why it goes out of service (the request's body)"};
            if (!out || !req.body.empty()) {
              state::CellStore store(cell_.state_folder());
-             answer = set_resource_service(cell_, store, resource, out ? req.body : "", "the operator (dashboard)");
+             answer = set_resource_service(cell_, store, resource, out ? req.body : "", who(req));
            }
            res.status = answer.status;
            res.set_content(nlohmann::json{{"resource", resource}, {"message", answer.message}}.dump(), "application/json");

@@ -30,11 +30,15 @@ class DashboardRoutes {
   DashboardRoutes(const CellConfig& cell, std::string token) : cell_(cell), token_(std::move(token)) {}
   // The server's limits, headers and gate, and every route of this class.
   void install(httplib::Server& server);
-  // Whether the request carries the token; if not, `res` says what is missing.
+  // Whether the request carries the token, or came (over TLS, with security) with a
+  // certificate of the cell's CA of one of the file's `operators:`; if not, `res` says what
+  // is missing.
   bool allowed(const httplib::Request& req, httplib::Response& res) const;
   const std::string& token() const { return token_; }
 
  private:
+  std::string operator_of(const httplib::Request& req) const;  // "" when no operator's certificate
+  std::string who(const httplib::Request& req) const;          // who acts, for the journal
   httplib::Server::HandlerResponse before_body(const httplib::Request& req, httplib::Response& res) const;
   void serve_page(const httplib::Request& req, httplib::Response& res) const;
   void serve_result(const std::string& order, const std::string& file, httplib::Response& res) const;

@@ -76,10 +76,15 @@ bool PhysicalScene::spawn(const cell::SimRequest& r) {
 }
 
 bool PhysicalScene::move(const cell::SimRequest& r, double sim_now) {
-  const auto mover = bodies_.find(r.body_id().to_string());
-  if (mover == bodies_.end() || r.path().empty() || !(r.speed() > 0) || !std::isfinite(r.speed()) ||
-      !(r.angular_speed() >= 0)) {
-    return false;
+  if (r.path().empty() || !(r.speed() > 0) || !std::isfinite(r.speed()) || !(r.angular_speed() >= 0)) return false;
+  auto mover = bodies_.find(r.body_id().to_string());
+  if (mover == bodies_.end()) {
+    const auto start = isometry(r.path().front());
+    if (!start || !resources_.count(r.requester().to_string()) || bodies_.size() >= kMaxBodies) return false;
+    Body body;
+    body.owner = r.requester().to_string();
+    body.pose = body.before = *start;
+    mover = bodies_.emplace(r.body_id().to_string(), std::move(body)).first;
   }
   Motion motion{{sim_now}, {mover->second.pose}};
   for (const cell::Pose& p : r.path()) {

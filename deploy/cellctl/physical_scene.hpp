@@ -7,6 +7,10 @@
 // and where a collision stopped it, or undoes it when cell-sim refused it. Bodies of virtual
 // scenes (the twins' virtual assembly) are not followed.
 //
+// Requests are events: a spawn made before this reader matched its writer is never heard (a
+// resource spawns its own bodies as it starts). A move by a resource of the cell of a body
+// never heard spawned takes the body in where the move begins, shapeless.
+//
 // Requests come from the network: a body past kMaxBodies, a pose that is not finite, a move
 // of a body never spawned here are ignored. Thread-safe: DDS threads feed it, the
 // dashboard's feed reads it.
@@ -14,6 +18,7 @@
 #include <cstddef>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,6 +31,9 @@ namespace cellctl {
 
 class PhysicalScene {
  public:
+  // `resources`: the cell's resource ids, the requesters whose moves of unknown bodies count.
+  explicit PhysicalScene(std::set<std::string> resources = {}) : resources_(std::move(resources)) {}
+
   static constexpr std::size_t kMaxBodies = 5000;
   static constexpr std::size_t kMaxMovesUnanswered = 4096;
 
@@ -57,6 +65,7 @@ class PhysicalScene {
   bool spawn(const cell::SimRequest& request);
   bool move(const cell::SimRequest& request, double sim_now);
 
+  const std::set<std::string> resources_;
   mutable std::mutex mutex_;
   std::map<std::string, Body> bodies_;
   std::map<std::string, std::vector<std::string>> moving_;  // request id -> the bodies its move took

@@ -95,7 +95,7 @@ void add_extension(X509* cert, X509* issuer, int nid, const char* value) {
 
 // Signed by `issuer_key`; self-signed when `issuer` is null.
 X509Ptr make_cert(const std::string& common_name, EVP_PKEY* key, X509* issuer, EVP_PKEY* issuer_key,
-                  const Validity& validity) {
+                  const Validity& validity, const std::vector<std::string>& alt_names = {}) {
   X509Ptr cert(X509_new());
   BnPtr serial(BN_new());
   if (!cert || !serial || !BN_rand(serial.get(), 63, BN_RAND_TOP_ANY, BN_RAND_BOTTOM_ANY) ||
@@ -118,6 +118,11 @@ X509Ptr make_cert(const std::string& common_name, EVP_PKEY* key, X509* issuer, E
   add_extension(cert.get(), signer, NID_basic_constraints, issuer ? "critical,CA:FALSE" : "critical,CA:TRUE");
   add_extension(cert.get(), signer, NID_key_usage, issuer ? "critical,digitalSignature,keyAgreement" : "critical,keyCertSign,cRLSign,digitalSignature");
   add_extension(cert.get(), signer, NID_subject_key_identifier, "hash");
+  if (!alt_names.empty()) {
+    std::string names;
+    for (const auto& n : alt_names) names += (names.empty() ? "" : ",") + n;
+    add_extension(cert.get(), signer, NID_subject_alt_name, names.c_str());
+  }
   if (!X509_sign(cert.get(), issuer_key, EVP_sha256())) fail("cannot sign the certificate of " + common_name);
   return cert;
 }
@@ -137,14 +142,15 @@ void make_ca(const fs::path& dir, const std::string& name, const Validity& valid
   write_file(dir / "ca.cert.pem", pem_of_cert(cert.get()), 0644);
 }
 
-void issue_certificate(const fs::path& dir, const std::string& name, const Validity& validity) {
+void issue_certificate(const fs::path& dir, const std::string& name, const Validity& validity,
+                       const std::vector<std::string>& alt_names) {
   const X509Ptr ca = read_cert(dir / "ca.cert.pem");
   const KeyPtr ca_key = read_key(dir / "ca.key.pem");
   const dds::IdentityFiles files = dds::identity_files(dir, name);
   fs::create_directories(files.cert.parent_path());
   fs::permissions(files.cert.parent_path(), fs::perms::owner_all);
   KeyPtr key = new_key();
-  X509Ptr cert = make_cert(name, key.get(), ca.get(), ca_key.get(), validity);
+  X509Ptr cert = make_cert(name, key.get(), ca.get(), ca_key.get(), validity, alt_names);
   write_file(files.key, pem_of_key(key.get()), 0600);
   write_file(files.cert, pem_of_cert(cert.get()), 0644);
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace cellctl::pki {
 
@@ -26,8 +27,10 @@ struct Validity {
 void make_ca(const std::filesystem::path& dir, const std::string& name, const Validity& validity);
 
 // Writes DIR/identities/NAME/key.pem (0600) and cert.pem (subject CN=NAME, signed by the CA
-// in DIR), replacing what was there.
-void issue_certificate(const std::filesystem::path& dir, const std::string& name, const Validity& validity);
+// in DIR), replacing what was there. `alt_names`: a TLS server's subjectAltName entries
+// ("IP:127.0.0.1", "DNS:localhost"), the names a client reaches it by.
+void issue_certificate(const std::filesystem::path& dir, const std::string& name, const Validity& validity,
+                       const std::vector<std::string>& alt_names = {});
 
 // Writes `document` to `file` (an XML file beside it keeps the text) signed by DIR's CA.
 void write_signed(const std::filesystem::path& dir, const std::string& document, const std::filesystem::path& file);

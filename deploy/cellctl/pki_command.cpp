@@ -41,7 +41,7 @@ void add_options(CLI::App* cmd, PkiOptions& o) {
 
 // The identity's certificate and key, and its permissions signed by the CA.
 void issue(const fs::path& dir, const pki::Grant& grant, int domain, const pki::Validity& validity) {
-  pki::issue_certificate(dir, grant.identity, validity);
+  pki::issue_certificate(dir, grant.identity, validity, grant.tls_names);
   pki::write_signed(dir, pki::permissions_xml(grant, domain, validity), dds::identity_files(dir, grant.identity).permissions);
 }
 
@@ -74,7 +74,7 @@ void add_pki_command(CLI::App& app, int& exit_code) {
   CLI::App* issue_cmd = pki_cmd->add_subcommand(
       "issue", "Issue (again) one identity of the cell with the CA in DIR: a new key, certificate and permissions");
   add_options(issue_cmd, *o);
-  issue_cmd->add_option("NAME", o->name, "The identity: cell-sim, a resource id of the file, twin-N, cellctl, order-desk or a client")->required();
+  issue_cmd->add_option("NAME", o->name, "The identity: cell-sim, a resource id of the file, twin-N, cellctl, order-desk, a client, dashboard or an operator")->required();
   issue_cmd->add_option("--backdate-days", o->backdate_days, "Valid from this many days ago (a test: an expired identity)")
       ->check(CLI::NonNegativeNumber);
   issue_cmd->callback([o, &exit_code] {

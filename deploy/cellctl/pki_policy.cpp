@@ -117,6 +117,16 @@ std::vector<Grant> cell_grants(const CellConfig& cell) {
                       Topics{desk_topic("replies", c), desk_topic("results", c)} + kEveryone});
   }
   grants.push_back(desk);
+  // The dashboard's TLS server and the people who may use it by certificate: no DDS.
+  Grant dashboard{"dashboard", "dashboard", {}, {}, {}};
+  dashboard.tls_names = {"IP:127.0.0.1", "DNS:localhost"};
+  if (!cell.dashboard.empty()) {
+    const std::string host = parse_dashboard_address(cell.dashboard).host;
+    const bool ip = host.find_first_not_of("0123456789.") == std::string::npos;
+    if (host != "127.0.0.1" && host != "0.0.0.0") dashboard.tls_names.push_back((ip ? "IP:" : "DNS:") + host);
+  }
+  grants.push_back(dashboard);
+  for (const auto& o : cell.operators) grants.push_back({o, "operator", {}, {}, {}});
   // The discovery servers relay who is there; they read and write no topic.
   grants.push_back({"discovery", "discovery", {}, {}, kEveryone});
   return grants;

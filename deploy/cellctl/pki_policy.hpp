@@ -13,18 +13,24 @@ namespace cellctl::pki {
 
 struct Grant {
   std::string identity;  // the certificate's CN and its folder under DIR/identities
-  std::string role;      // cell-sim, station, mobile-robot, buffer, twin, cellctl, order-desk, client
+  // cell-sim, station, mobile-robot, buffer, twin, cellctl, order-desk, client; and two that
+  // never join DDS (no topic): dashboard (the TLS server of cellctl up's page) and operator
+  // (a person at the dashboard, by a client certificate)
+  std::string role;
   std::vector<std::string> own_partitions;  // the ids it writes its capability and command events as
   std::vector<std::string> publish, subscribe;
   // Besides the owned topics (dds::owned_topic), the topics in partitions: written in its own
   // ones only, read in every one. A robot's gives to buffers; a buffer's commands, which it
   // takes from the robot they name alone.
   std::vector<std::string> as_itself = {};
+  // A TLS server's: the names its certificate is valid for (subjectAltName).
+  std::vector<std::string> tls_names = {};
 };
 
 // One per process of the cell (cell-sim, each station, robot and buffer), one per twin that
-// may run at once (twin-1 .. twin-N, the file's twin_identities), one for cellctl, the operator's observer, one for cellctl up ("order-desk"), and
-// one per client of the file's `clients:`.
+// may run at once (twin-1 .. twin-N, the file's twin_identities), one for cellctl, the operator's observer, one for cellctl up ("order-desk"),
+// one per client of the file's `clients:`, the dashboard's server ("dashboard": 127.0.0.1,
+// localhost and the file's `dashboard:` address) and one per operator of the file's `operators:`.
 std::vector<Grant> cell_grants(const CellConfig& cell);
 
 // Authenticated participants only; discovery, liveliness and every topic's data encrypted;

@@ -60,7 +60,16 @@ Process::Process(std::string name, const std::vector<std::string>& argv, const s
   std::vector<char*> environment;
   for (auto& v : variables) environment.push_back(v.data());
   environment.push_back(nullptr);
-  const int spawned = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environment.data());
+  // Each process starts with SIGPIPE as the system has it, whatever cellctl ignores (the dashboard).
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGPIPE);
+  posix_spawnattr_setsigdefault(&attributes, &defaults);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
+  const int spawned = posix_spawn(&pid_, args[0], &actions, &attributes, args.data(), environment.data());
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&actions);
   if (with_input) {
     ::close(input[1]);

@@ -251,6 +251,10 @@ function percentile(values, p) {
                     " ms over " + latencies.length + " updates; to the state built: p50 " + ms(built, 0.5) +
                     " ms, p99 " + ms(built, 0.99) + " ms; to the page's script: p50 " + ms(received, 0.5) + " ms, p99 " +
                     ms(received, 0.99) + " ms");
+        const drawMs = await page.evaluate(() => window.dashboard.drawMs);
+        console.log("drawing, p50 / p99 / max ms: " + Object.entries(drawMs).map(([part, times]) =>
+          part + " " + [0.5, 0.99].map((p) => percentile(times, p).toFixed(1)).join(" / ") + " / " +
+          Math.max(...times).toFixed(1) + " (" + times.length + ")").join(", "));
       } else {
         problems.push("no update reached the page");
       }

@@ -38,7 +38,16 @@ class RawConnection {
     connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&at), sizeof at) == 0 &&
                  ::send(fd_, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size());
   }
-  ~RawConnection() { ::close(fd_); }
+  ~RawConnection() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  // Ends the connection at once with a reset, as a browser's tab closed mid-answer can.
+  void reset() {
+    const linger now{1, 0};
+    ::setsockopt(fd_, SOL_SOCKET, SO_LINGER, &now, sizeof now);
+    ::close(fd_);
+    fd_ = -1;
+  }
   RawConnection(const RawConnection&) = delete;
   RawConnection& operator=(const RawConnection&) = delete;
   bool connected() const { return connected_; }
@@ -181,6 +190,20 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
     // The first 24 hold the other threads until the read timeout (2 s) ends them; then it is
     // answered. (Bounded, not timed to the millisecond: a loaded machine may take longer.)
     CHECK(std::chrono::steady_clock::now() - asked < 12s);
+  }
+
+  SECTION("pages that leave mid-answer end their own connections, not the cell") {
+    for (int i = 0; i < 20; ++i) {
+      RawConnection leaving(port, "GET /three.js HTTP/1.1\r\nHost: x\r\n\r\n");  // 600 kB to write
+      REQUIRE(leaving.connected());
+      std::this_thread::sleep_for(std::chrono::milliseconds(i % 4));
+      if (i % 2) leaving.reset();  // else closed as it goes: the server's next write draws a reset
+    }
+    std::this_thread::sleep_for(1s);
+    CHECK(cell.up->running());
+    auto r = client.Get("/state", {{"Authorization", "Bearer " + token}});
+    REQUIRE(r);
+    CHECK(r->status == 200);
   }
 
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);

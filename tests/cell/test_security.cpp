@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 
 #include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -407,11 +408,15 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
                                   dir / "after.log");
   INFO(test::read_text(dir / "after.log") << up_log());
   CHECK(order == 0);
-  {  // The dashboard read cell-sim's requests under the desk's permissions: the cell's bodies.
+  {  // The dashboard read cell-sim's requests under the desk's permissions: the bodies that
+     // moved for the order (the robot's base, the arm's gripper; a table's spawn at the
+     // station's start may come before the dashboard's reader is matched).
     const std::string log = up_log();
     std::smatch m;
-    REQUIRE(std::regex_search(log, m, std::regex("dashboard: http://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
-    httplib::Client client("127.0.0.1", std::stoi(m[1]));
+    REQUIRE(std::regex_search(log, m, std::regex("dashboard: https://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
+    httplib::SSLClient client("127.0.0.1", std::stoi(m[1]));
+    client.set_ca_cert_path((pki / "ca.cert.pem").c_str());
+    client.enable_server_certificate_verification(true);
     const auto state = client.Get("/state", {{"Authorization", "Bearer " + m[2].str()}});
     REQUIRE(state);
     const nlohmann::json bodies = nlohmann::json::parse(state->body)["bodies"];
@@ -419,9 +424,87 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
     for (const auto& b : bodies) owners.insert(b["owner"].get<std::string>());
     INFO(bodies.dump());
     CHECK(owners.count("mobile-robot-1"));
-    CHECK(owners.count("station-1"));
     CHECK(owners.count("arm-1"));
   }
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("secure dashboard: HTTPS with the cell's CA, an operator's certificate lets in without the token, a twin's or a stranger's does not",
+          "[process][security][dashboard]") {
+  // A client of a server that ends the handshake: its next write must fail, not end the test.
+  std::signal(SIGPIPE, SIG_IGN);
+  const fs::path dir = test::scratch("secure-dashboard");
+  const std::string domain = "223";
+  const fs::path cell = dir / "cell.yaml", pki = dir / "pki", foreign = dir / "foreign";
+  std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nsecurity: pki\noperators: [alice]\n";
+  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
+  REQUIRE(test::cellctl({"pki", "init", foreign.string(), "--cell", cell.string(), "--domain", domain}, dir / "foreign.log") == 0);
+  test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--state-dir", (dir / "state").string(),
+                         "--dashboard", "127.0.0.1:0"},
+                        (dir / "up.log").string());
+  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 90s));
+  const std::string log = test::read_text(dir / "up.log");
+  INFO(log);
+  std::smatch m;
+  REQUIRE(std::regex_search(log, m, std::regex("dashboard: https://127\\.0\\.0\\.1:(\\d+)/\\?token=([0-9a-f]+)")));
+  const int port = std::stoi(m[1]);
+  const std::string token = m[2];
+  // A browser of `identity` (its certificate and key from `from`; none: "") that trusts the cell's CA.
+  const auto as = [&](const std::string& identity, const fs::path& from = {}) {
+    const fs::path id = (from.empty() ? pki : from) / "identities" / identity;
+    auto client = identity.empty() ? std::make_unique<httplib::SSLClient>("127.0.0.1", port)
+                                   : std::make_unique<httplib::SSLClient>("127.0.0.1", port, (id / "cert.pem").string(),
+                                                                          (id / "key.pem").string());
+    client->set_ca_cert_path((pki / "ca.cert.pem").c_str());
+    client->enable_server_certificate_verification(true);
+    client->set_connection_timeout(5);
+    return client;
+  };
+
+  const auto alice = as("alice")->Get("/state");
+  REQUIRE(alice);
+  CHECK(alice->status == 200);
+  CHECK(nlohmann::json::parse(alice->body).contains("resources"));
+  const auto page = as("alice")->Get("/");
+  REQUIRE(page);
+  CHECK(page->status == 200);
+
+  const auto nobody = as("")->Get("/state");
+  REQUIRE(nobody);
+  CHECK(nobody->status == 401);
+  const auto with_token = as("")->Get("/state", {{"Authorization", "Bearer " + token}});
+  REQUIRE(with_token);
+  CHECK(with_token->status == 200);
+  const auto twin = as("twin-1")->Get("/state");  // the cell's CA signed it, but it is no operator
+  REQUIRE(twin);
+  CHECK(twin->status == 401);
+  CHECK_FALSE(as("alice", foreign)->Get("/state"));  // another CA's alice: no handshake
+  httplib::Client plain("127.0.0.1", port);
+  plain.set_connection_timeout(5);
+  const auto in_clear = plain.Get("/state", {{"Authorization", "Bearer " + token}});
+  CHECK((!in_clear || in_clear->status != 200));
+
+  // Pages that leave: each takes the first event of the live stream and closes its connection;
+  // the dashboard's next writes to them (the states alice's actions make, below) find them
+  // gone, and a TLS write to a closed socket draws SIGPIPE.
+  for (int i = 0; i < 4; ++i) as("alice")->Get("/events", [](const char*, std::size_t) { return false; });
+
+  // What alice does is hers in the cell's journal.
+  const auto out = as("alice")->Post("/resources/buffer-2/out-of-service", "bin count", "text/plain");
+  REQUIRE(out);
+  CHECK(out->status == 200);
+  CHECK(test::cellctl({"status", "--cell", cell.string(), "--domain", domain, "--json"}, dir / "status.log", 30s) == 0);
+  CHECK(test::read_text(dir / "status.log").find("bin count (operator alice (dashboard))") != std::string::npos);
+  const auto back = as("alice")->Post("/resources/buffer-2/in-service", "", "text/plain");
+  REQUIRE(back);
+  CHECK(back->status == 200);
+  for (const char* way : {"out-of-service", "in-service", "out-of-service", "in-service"}) {
+    as("alice")->Post(std::string("/resources/buffer-1/") + way, "again", "text/plain");
+    std::this_thread::sleep_for(300ms);
+  }
+  CHECK(up.running());
+
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }

@@ -118,3 +118,14 @@ TEST_CASE("deployment: dashboard is [ADDR:]PORT, loopback unless ADDR says, none
   CHECK_THROWS_WITH(cell_with("dashboard: web\n"), Catch::Contains(":2"));
   CHECK_THROWS_AS(cellctl::parse_dashboard_address(":8080"), cellctl::ConfigError);
 }
+
+TEST_CASE("deployment: operators are names of their own (their certificates' too), none by default", "[cellctl][config]") {
+  CHECK(cell_with("").operators.empty());
+  CHECK(cell_with("operators: [alice, bob]\n").operators == std::vector<std::string>{"alice", "bob"});
+  CHECK_THROWS_WITH(cell_with("operators: [Alice]\n"), Catch::Contains(":2: a name in operators is 1 to 64 of a-z"));
+  CHECK_THROWS_WITH(cell_with("clients: [alice]\noperators: [alice]\n"),
+                    Catch::Contains("'alice' of operators has the name of a resource, of another client or operator"));
+  for (const std::string taken : {"dashboard", "order-desk", "twin-3", "station-1"}) {
+    CHECK_THROWS_WITH(cell_with("operators: [" + taken + "]\n"), Catch::Contains("has the name of"));
+  }
+}

@@ -107,6 +107,19 @@ TEST_CASE("a robot's drive runs at its speed with the part it carries, from when
   CHECK(scene.size() == 1);
 }
 
+TEST_CASE("a resource's body whose spawn was not heard is taken in by its first move", "[cellctl][dashboard]") {
+  cellctl::PhysicalScene scene({"mobile-robot-1"});
+  scene.take(move("m1", "mobile-robot-1/base", {pose(2, 0, 0), pose(2, 0, 1)}, 0.5), 10);  // requester mobile-robot-1
+  const auto base = body_of(scene, "mobile-robot-1/base", 11);
+  REQUIRE(base.is_object());
+  CHECK(base["owner"] == "mobile-robot-1");
+  CHECK(base["motion"]["t"] == nlohmann::json({10.0, 10.0, 12.0}));
+  auto stranger = move("m2", "o1/virtual/brick", {pose(1, 0, 0)}, 1);
+  stranger.requester("o1");  // a twin's virtual body
+  scene.take(stranger, 10);
+  CHECK(scene.size() == 1);
+}
+
 TEST_CASE("a move that collides stops where it hit, and one cell-sim refused did not happen", "[cellctl][dashboard]") {
   cellctl::PhysicalScene scene;
   scene.take(spawn("arm-1/palm", "arm-1", "", pose(0, 1, 0)), 0);
@@ -135,7 +148,7 @@ TEST_CASE("the physical scene leaves out what it cannot draw: bad poses, strange
   CHECK(scene.size() == 0);
 
   scene.take(spawn("c", "arm-1", "", pose(0, 0, 0)), 0);
-  scene.take(move("m1", "nobody", {pose(1, 0, 0)}, 1), 0);
+  scene.take(move("m1", "nobody", {pose(1, 0, 0)}, 1), 0);  // by a requester that is no resource of the cell
   scene.take(move("m2", "c", {pose(1, 0, 0)}, 0), 0);                     // no speed
   scene.take(move("m3", "c", {pose(1, 0, 0), pose(1, nan, 0)}, 1), 0);    // a bad waypoint
   scene.take(move("m4", "c", {pose(1, std::numeric_limits<double>::infinity(), 0)}, 1), 0);

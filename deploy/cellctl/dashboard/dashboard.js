@@ -4,7 +4,7 @@
 (function () {
   // What the page saw, for whoever checks it: each resource's states in turn ("idle", "gone"...).
   const page = (window.dashboard = { states: 0, latencies: [], built: [], received: [], bars: [], state: null, seen: {},
-                                     movingFrames: 0, parts: {} });
+                                     movingFrames: 0, parts: {}, drawMs: { scene: [], gantt: [], tables: [] } });
   let receivedAt = 0; // wall s when the last state came
   let lastHeard = 0;
 
@@ -280,7 +280,7 @@
     scene.key = key;
     scene.wasMoving = moving;
     scene.drawnAt = Date.now();
-    renderScene(s, t);
+    timed("scene", () => renderScene(s, t));
     if (moving) {
       page.movingFrames += 1;
       again();
@@ -293,15 +293,25 @@
   function drawSlow() {
     slowPending = false;
     slowDrawn = Date.now();
-    renderGantt();
+    timed("gantt", renderGantt);
+  }
+  // How long each part of the page takes to draw (ms, the last 1000), for docs/performance.md.
+  function timed(part, draw) {
+    const began = performance.now();
+    draw();
+    const times = page.drawMs[part];
+    times.push(performance.now() - began);
+    if (times.length > 1000) times.shift();
   }
   function render(s) {
-    document.getElementById("domain").textContent = "on domain " + s.domain;
-    renderAttention(s.attention);
-    renderResources(s.resources);
-    renderOrders(s.orders);
-    renderInventory(s.inventory);
-    renderAlarms(s.alarms);
+    timed("tables", () => {
+      document.getElementById("domain").textContent = "on domain " + s.domain;
+      renderAttention(s.attention);
+      renderResources(s.resources);
+      renderOrders(s.orders);
+      renderInventory(s.inventory);
+      renderAlarms(s.alarms);
+    });
     drawScene();
     if (slowPending) return;
     slowPending = true;
@@ -393,6 +403,6 @@
   setInterval(() => {
     if (!page.state) return;
     document.getElementById("clock").textContent = "sim " + simNow().toFixed(1) + " s";
-    renderGantt();
+    timed("gantt", renderGantt);
   }, 1000);
 })();
