@@ -229,8 +229,8 @@
         continue;
       }
       const { p, q } = poseAt(b, t);
-      const mesh = b.mesh ? meshOf("body:" + b.id, () => new THREE.BoxGeometry(0.04, 0.04, 0.04))
-                          : meshOf("body:" + b.id, () => new THREE.BoxGeometry(2 * size[0], 2 * size[1], 2 * size[2]));
+      const mesh = meshOf("body:" + b.id, () => b.mesh ? new THREE.BoxGeometry(0.04, 0.04, 0.04)
+                                                    : new THREE.BoxGeometry(2 * size[0], 2 * size[1], 2 * size[2]));
       mesh.position.copy(p);
       mesh.quaternion.copy(q);
       mesh.material.color.set(b.mesh ? "hsl(" + hue(b.order) + ", 65%, 45%)" : b.owner.startsWith("station") ? 0xb8c0c8 : 0x455a64);
@@ -266,8 +266,8 @@
     scene.camera.lookAt(centre);
     scene.framed = true;
   }
-  // Drawn when the view changed, and while something moves, at most ten times a second
-  // (software rendering takes tens of ms a frame).
+  // Drawn when the view changed, and while something moves, at most ten times a second (in
+  // software a frame takes milliseconds to tens of them, the first up to a second).
   function drawScene() {
     const s = page.state;
     if (!scene.ready || !s || scene.nextFrame) return;
