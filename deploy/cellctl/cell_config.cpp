@@ -269,8 +269,8 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   if (c.currency.empty() || c.currency.size() > 8) throw ConfigError(where(file, root["currency"]) + ": currency is 1 to 8 characters");
   read(file, root, "clients", c.clients);
   read(file, root, "operators", c.operators);
-  for (const char* key : {"clients", "operators"}) {
-    for (const auto& id : std::string(key) == "clients" ? c.clients : c.operators) {
+  for (const auto& [key, names] : {std::pair{"clients", &c.clients}, std::pair{"operators", &c.operators}}) {
+    for (const auto& id : *names) {
       if (id.empty() || id.size() > 64 || id.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos) {
         throw ConfigError(where(file, root[key]) + ": a name in " + key + " is 1 to 64 of a-z, 0-9, - and _ ('" + id +
                           "' is not)");
@@ -335,8 +335,8 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   }
   // A client's and an operator's name is their DDS-Security identity too: none may be another's.
   ids.insert({"cell-sim", "twin", "cellctl", "order-desk", "dashboard", "discovery"});
-  for (const char* key : {"clients", "operators"}) {
-    for (const auto& id : std::string(key) == "clients" ? c.clients : c.operators) {
+  for (const auto& [key, names] : {std::pair{"clients", &c.clients}, std::pair{"operators", &c.operators}}) {
+    for (const auto& id : *names) {
       if (!ids.insert(id).second || is_twin_identity(id)) {
         throw ConfigError(where(file, root[key]) + ": '" + id + "' of " + key + " has the name of a resource, of another " +
                           "client or operator, or of cell-sim, twin, twin-N, cellctl, order-desk, dashboard or discovery");
