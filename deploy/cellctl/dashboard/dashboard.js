@@ -312,7 +312,8 @@
       renderInventory(s.inventory);
       renderAlarms(s.alarms);
     });
-    drawScene();
+    // After this frame is painted: the tables' change is on the screen before the 3D view's draw.
+    setTimeout(drawScene, 0);
     if (slowPending) return;
     slowPending = true;
     setTimeout(drawSlow, Math.max(0, slowDrawn + 250 - Date.now()));
