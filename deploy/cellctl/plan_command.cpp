@@ -10,6 +10,7 @@
 #include "deploy/cellctl/text_table.hpp"
 #include "deploy/cellctl/video.hpp"
 #include "twin/description/automationml/precedence_writer.hpp"
+#include "twin/planning/build_orientation.hpp"
 #include "twin/planning/precedence_suggestions.hpp"
 #include "twin/report/plan_json.hpp"
 #include "twin/geometry/product_loader.hpp"
@@ -93,11 +94,13 @@ void add_plan_command(CLI::App& app, int& exit_code) {
       planning.fixtures = cell.fixtures;
     }
     sim::MeshCache meshes;
-    const twin::LoadedProduct loaded = twin::load_product(options->product, meshes);
-    twin::require_geometry(loaded);
+    const twin::LoadedProduct as_given = twin::load_product(options->product, meshes);
+    twin::require_geometry(as_given);
     auto sequence = twin::make_sequence_planner(options->sequence);
     auto path = twin::make_path_planner(options->path);
-    twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, planning);
+    twin::OrientedPlan oriented = twin::plan_in_build_orientation(as_given, *sequence, *path, planning);
+    const twin::LoadedProduct& loaded = oriented.product;  // as it is built
+    twin::Plan& plan = oriented.plan;
     std::vector<twin::PrecedenceSuggestion> suggestions;
     if (!options->suggest.empty()) suggestions = twin::suggest_precedences(loaded, plan, *sequence, *path, planning);
     print_plan(loaded.product, plan, std::cout);

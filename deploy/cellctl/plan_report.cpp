@@ -23,6 +23,7 @@ void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostre
       << "): " << (plan.complete ? "complete" : "INCOMPLETE") << ", " << placed << " of " << product.parts().size()
       << " parts";
   if (!plan.subassemblies.empty()) out << ", " << plan.subassemblies.size() << " subassembl" << (plan.subassemblies.size() == 1 ? "y" : "ies");
+  if (plan.orientation != "as finished") out << ", built " << plan.orientation;
   out << "\n\n";
   // A subassembly's own steps read "ShaftPendulum: shaft", built aside; its insertion
   // "ShaftPendulum (shaft, pendulum)".

@@ -278,6 +278,43 @@ TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm opera
   CHECK(turning == Approx(2 * M_PI * screw["turns"].get<double>()).epsilon(0.05));
 }
 
+TEST_CASE("cell run: a table whose pin goes in from below is built upside down and delivered so", "[process][cell]") {
+  const fs::path dir = scratch("upside-down");
+  std::string cell = read_text(std::string(DEPLOY_CELLS) + "/default.yaml");
+  cell = cell.substr(0, cell.find("buffers:")) +
+         "buffers:\n  - id: buffer-1\n    position: [2.0, 0, -0.8]\n    stock: {Plate: 1, Leg: 4, Pin: 1}\n";
+  fs::create_directories(dir);
+  { std::ofstream(dir / "cell.yaml") << cell; }
+  test::clean_stale_dds_segments();
+  const int code = cellctl({"run", "--cell", (dir / "cell.yaml").string(), std::string(TEST_DATA_DIR) +
+                            "/planning/upside-down/table-with-pin.aml", "--domain", "204", "--real-time-factor", "50",
+                            "--events", (dir / "events.jsonl").string(), "--out", (dir / "out").string(), "--order", "order-1"},
+                           dir / "cellctl.log");
+  INFO(read_text(dir / "cellctl.log"));
+  REQUIRE(code == 0);
+  const json plan = json::parse(read_text(dir / "out" / "plan.json"));
+  CHECK(plan["complete"] == true);
+  CHECK(plan["orientation"] == "upside down");
+  const auto said = std::find_if(plan["findings"].begin(), plan["findings"].end(),
+                                 [](const json& f) { return f["kind"] == "orientation"; });
+  REQUIRE(said != plan["findings"].end());
+  CHECK_THAT((*said)["message"].get<std::string>(), Catch::Contains("delivered upside down"));
+  // The cell put the plate down first and the pin into it from above, turned over: the pin's
+  // last pose is half a turn about x from how it stands in the finished product.
+  std::vector<std::string> gripped;
+  for (const auto& e : read_events(dir / "events.jsonl")) {
+    if (e["event"] == "succeeded" && e["resource"] == "arm-1" && e["operation"] == "grip") gripped.push_back(e["part"]);
+  }
+  REQUIRE(gripped.size() == 6);
+  CHECK(gripped[0] == "order-1/plate");
+  CHECK(gripped[1] == "order-1/pin");
+  const json& pin = plan["steps"][1];
+  REQUIRE(pin["part"] == "pin");
+  const json& last = pin["trajectory"].back();
+  CHECK(std::abs(last["orientation"][1].get<double>()) == Approx(1).margin(1e-9));  // (w, x, y, z)
+  CHECK(last["position"][1].get<double>() == Approx(0.012).margin(1e-6));         // its head on the plate
+}
+
 TEST_CASE("cell up: a bad order fails alone, one with a subassembly is built, the cell stays idle and usable, down ends it", "[process][cell]") {
   test::clean_stale_dds_segments();
   const fs::path dir = scratch("bad-order");

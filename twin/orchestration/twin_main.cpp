@@ -38,6 +38,7 @@
 #include "twin/model/source_ref.hpp"
 #include "twin/orchestration/order_network.hpp"
 #include "twin/orchestration/quote.hpp"
+#include "twin/planning/build_orientation.hpp"
 #include "twin/planning/sequence_planner.hpp"
 #include "twin/planning/subassembly_planner.hpp"
 #include "twin/report/gltf_animation.hpp"
@@ -48,6 +49,14 @@
 #include "services/state/cell_store.hpp"
 
 namespace {
+
+// Why a plan is incomplete, in a line: its last finding but the orientations' summary.
+std::string why_incomplete(const twin::Plan& plan) {
+  for (auto f = plan.findings.rbegin(); f != plan.findings.rend(); ++f) {
+    if (f->kind != "orientation") return f->message;
+  }
+  return "no complete plan";
+}
 
 const std::atomic<bool>& running = services::running_flag();
 
@@ -131,18 +140,18 @@ class TwinProcess {
     } catch (const twin::DescriptionError& e) {
       return end_with(2, std::string("bad product description: ") + e.what());
     }
-    const twin::LoadedProduct& product = *loaded;
-    status("PLANNING", "planning " + std::to_string(product.product.parts().size()) + " parts", 0);
+    status("PLANNING", "planning " + std::to_string(loaded->product.parts().size()) + " parts", 0);
     auto path = twin::make_path_planner(options_.path);
     twin::PlannerOptions planning;
     planning.gripper = options_.gripper;
     planning.fixtures = options_.fixtures;
-    twin::Plan plan = plan_order(product, *path, planning);
+    twin::OrientedPlan oriented = plan_order(*loaded, *path, planning);
+    const twin::LoadedProduct& product = oriented.product;  // as the cell builds it
+    const twin::Plan& plan = oriented.plan;
     std::filesystem::create_directories(options_.out);
     const auto plan_file = std::filesystem::absolute(options_.out) / "plan.json";
     if (!plan.complete) {
-      std::string why = "planning found no complete assembly: " +
-                        (plan.findings.empty() ? std::string("no complete plan") : plan.findings.back().message);
+      const std::string why = "planning found no complete assembly: " + why_incomplete(plan);
       if (options_.quote) return end_quote(product, twin::infeasible_quote(why, options_.rates), plan);
       write_plan(product, plan, plan_file);
       return end_with(1, why, plan_file.string());
@@ -154,24 +163,26 @@ class TwinProcess {
   // A twin taking up an order whose physical assembly had begun follows the order its
   // predecessor stored (the parts in place were put in by it); where that no longer plans
   // (another cell-sim, another build), it plans anew and the journal says so.
-  twin::Plan plan_order(const twin::LoadedProduct& product, twin::PathPlanner& path, const twin::PlannerOptions& options) {
+  // Either may be in another orientation than the finished product's (build_orientation.hpp).
+  twin::OrientedPlan plan_order(const twin::LoadedProduct& product, twin::PathPlanner& path,
+                                const twin::PlannerOptions& options) {
     const auto stored = store_ ? store_->plan_of(options_.order) : std::vector<state::PlanStepRecord>{};
     if (!stored.empty()) {
       std::vector<std::string> ids;
       for (const auto& s : stored) ids.push_back(s.step);
       twin::GivenSequencePlanner given(ids);
-      twin::Plan plan = twin::plan_assembly(product, given, path, options);
+      twin::OrientedPlan oriented = twin::plan_in_build_orientation(product, given, path, options);
+      const twin::Plan& plan = oriented.plan;
       if (plan.complete) {
         store_->journal("twin-" + options_.order, "plan followed", options_.order,
                         "the stored order of " + std::to_string(stored.size()) + " steps");
-        return plan;
+        return oriented;
       }
       store_->journal("twin-" + options_.order, "plan not followed", options_.order,
-                      "the stored order did not plan again: " +
-                          (plan.findings.empty() ? std::string("incomplete") : plan.findings.back().message));
+                      "the stored order did not plan again: " + why_incomplete(plan));
     }
     const auto sequence = twin::make_sequence_planner(options_.sequence);
-    return twin::plan_assembly(product, *sequence, path, options);
+    return twin::plan_in_build_orientation(product, *sequence, path, options);
   }
 
   // The plan physical assembly follows, as virtual assembly validated it.

@@ -72,6 +72,8 @@ struct Plan {
   double margin_threshold = 0, margin_reach = 0;  // m, as planned with (PlannerOptions)
   PlanVerification verification;
   bool stability = false;  // every state asked whether it stands (PlannerOptions::stability)
+  // How the product stands while it is built, and as the cell delivers it (build_orientation.hpp).
+  std::string orientation = "as finished";
 };
 
 // How the search goes, for a person waiting: each part put in and each one taken off again.

@@ -111,6 +111,7 @@ nlohmann::json plan_json(const Product& product, const Plan& plan) {
           {"sequence_planner", plan.sequence_planner},
           {"path_planner", plan.path_planner},
           {"backtracks", plan.backtracks},
+          {"orientation", plan.orientation},
           {"margin_threshold", plan.margin_threshold},
           {"verification", {{"run", plan.verification.run},
                             {"passed", plan.verification.passed},
