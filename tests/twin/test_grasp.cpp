@@ -1,9 +1,12 @@
 // The parallel gripper's grasps: which ones a part has, in which order, and how virtual
 // assembly picks one that is free of collisions.
 
+#include "tests/support/generated_products.hpp"
+#include "tests/support/meshes.hpp"
 #include "tests/twin/test_support.hpp"
 #include "twin/planning/assembly_planner.hpp"
 #include "twin/planning/finger_contact.hpp"
+#include "twin/planning/grasp.hpp"
 
 namespace {
 
@@ -216,4 +219,45 @@ TEST_CASE("grasps: low walls are held deep, a grasp that closes on air is said b
   REQUIRE(plan_alone.complete);
   CHECK(scene.holds(0, plan_alone.steps[0].trajectory.grasp));
   CHECK(plan_alone.steps[0].trajectory.grasp.label.find("from -x") != std::string::npos);
+}
+
+TEST_CASE("grasps: the footprint's turn is the side of its smallest rectangle", "[planning][grasp]") {
+  // A 60 x 20 mm rectangle, 10 mm tall, turned 30 degrees about the vertical.
+  std::vector<Vec3> points;
+  const Eigen::AngleAxisd turn(-M_PI / 6, Vec3::UnitY());  // takes x to (cos 30, 0, sin 30)
+  for (double x : {-0.03, 0.03}) {
+    for (double y : {0.0, 0.01}) {
+      for (double z : {-0.01, 0.01}) points.push_back(turn * Vec3(x, y, z));
+    }
+  }
+  CHECK(twin::footprint_yaw(points) == Approx(M_PI / 6).margin(1e-9));
+  const twin::Pose unturn = twin::unturn_by(twin::footprint_yaw(points));
+  Eigen::AlignedBox3d box;
+  for (const Vec3& p : points) box.extend(unturn * p);
+  CHECK(box.sizes().x() == Approx(0.06).margin(1e-9));
+  CHECK(box.sizes().z() == Approx(0.02).margin(1e-9));
+  points = {Vec3(0, 0, 0), Vec3(0.05, 0, 0), Vec3(0.05, 0, 0.02), Vec3(0, 0, 0.02)};
+  CHECK(twin::footprint_yaw(points) == Approx(0).margin(1e-9));
+}
+
+TEST_CASE("grasps: a bar lying turned 45 degrees is held across its own width, not across its box in the world's axes",
+          "[planning][grasp]") {
+  // 250 x 20 x 20 mm on the station, turned 45 degrees: its box in the world's axes is 191 mm
+  // across x and z, wider than this gripper opens (150 mm), and across y a finger would go
+  // under it into the station.
+  test::ProductMaker make("turned-bar");
+  sim::TriangleMesh bar = test::box_mesh(Vec3(0.125, 0.01, 0.01));
+  const Eigen::AngleAxisd turn(M_PI / 4, Vec3::UnitY());
+  for (auto& v : bar.vertices) v = turn * v + Vec3(0, 0.01, 0);
+  bar.bounds = {};
+  for (const auto& v : bar.vertices) bar.bounds.extend(v);
+  make.part("bar", std::move(bar));
+  const twin::LoadedProduct product = make.take();
+  twin::PlannerOptions options;
+  options.gripper.max_opening = 0.15;
+  const twin::Plan plan = plan_of(product, options);
+  REQUIRE(plan.complete);
+  const twin::Grasp& grasp = plan.steps.front().trajectory.grasp;
+  CHECK_THAT(grasp.label, Catch::Contains("turned 45 deg"));
+  CHECK(grasp.opening == Approx(0.02).margin(1e-9));
 }

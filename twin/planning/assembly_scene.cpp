@@ -105,7 +105,31 @@ void AssemblyScene::update_frontier(PartIndex part) {
 }
 
 std::vector<Grasp> AssemblyScene::grasps(PartIndex part, const Vec3& direction) const {
-  return grasps_for(grasp_bounds_[part], product_.product.parts()[part].final_pose, direction, gripper_);
+  const Pose& final_pose = product_.product.parts()[part].final_pose;
+  std::vector<Grasp> out = grasps_for(grasp_bounds_[part], final_pose, direction, gripper_);
+  // Then, for a part that stands turned about the vertical, across its own faces.
+  const Footprint& f = footprint(part);
+  if (f.turned) {
+    auto turned = turned_grasps_for(f.turned_box, f.yaw, final_pose, direction, gripper_);
+    out.insert(out.end(), turned.begin(), turned.end());
+  }
+  return out;
+}
+
+const AssemblyScene::Footprint& AssemblyScene::footprint(PartIndex part) const {
+  auto [it, made] = footprints_.try_emplace(part);
+  Footprint& f = it->second;
+  const auto& mesh = held_by(part);
+  if (!made || !mesh) return f;
+  std::vector<Vec3> points;
+  points.reserve(mesh->vertices.size());
+  for (const auto& v : mesh->vertices) points.push_back(product_.product.parts()[part].final_pose * v);
+  f.yaw = footprint_yaw(points);
+  // Within a degree of the axes the boxes are the same.
+  f.turned = std::min(f.yaw, M_PI / 2 - f.yaw) > M_PI / 180;
+  const Pose unturn = unturn_by(f.yaw);
+  for (const Vec3& p : points) f.turned_box.extend(unturn * p);
+  return f;
 }
 
 const HeldPart& AssemblyScene::hold(PartIndex part, const Grasp& grasp) const {

@@ -134,6 +134,15 @@ class AssemblyScene {
 
   // What the gripper holds the part by (LoadedProduct::held_by).
   const std::shared_ptr<const sim::TriangleMesh>& held_by(PartIndex part) const;
+  // How what the gripper holds a part by stands turned about the vertical (grasp.hpp), found
+  // when its grasps are first asked.
+  struct Footprint {
+    double yaw = 0;
+    bool turned = false;  // more than a degree off the axes
+    Eigen::AlignedBox3d turned_box;  // in the world turned back by the yaw
+  };
+  const Footprint& footprint(PartIndex part) const;
+  mutable std::map<PartIndex, Footprint> footprints_;
 
   std::vector<Eigen::AlignedBox3d> bounds_;
   std::vector<Eigen::AlignedBox3d> grasp_bounds_;  // of what the gripper holds each part by

@@ -1,6 +1,11 @@
 #include "twin/planning/grasp.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/convex_hull_2.h>
 
 namespace twin {
 namespace {
@@ -66,6 +71,47 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
       if (deep > half + kDeepGraspClearance) add(deep, ", deep");
     }
   }
+  return out;
+}
+
+double footprint_yaw(const std::vector<Vec3>& points) {
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_2;
+  std::vector<Point> footprint, hull;
+  footprint.reserve(points.size());
+  for (const Vec3& p : points) footprint.emplace_back(p.x(), p.z());
+  CGAL::convex_hull_2(footprint.begin(), footprint.end(), std::back_inserter(hull));
+  double best_area = std::numeric_limits<double>::infinity(), best_yaw = 0;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Point& a = hull[i];
+    const Point& b = hull[(i + 1) % hull.size()];
+    const double dx = b.x() - a.x(), dz = b.y() - a.y(), length = std::hypot(dx, dz);
+    if (length == 0) continue;
+    const double ux = dx / length, uz = dz / length;  // along the edge, and (-uz, ux) across it
+    double lo_u = 0, hi_u = 0, lo_v = 0, hi_v = 0;
+    for (const Point& q : hull) {
+      const double u = (q.x() - a.x()) * ux + (q.y() - a.y()) * uz, v = -(q.x() - a.x()) * uz + (q.y() - a.y()) * ux;
+      lo_u = std::min(lo_u, u), hi_u = std::max(hi_u, u), lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
+    }
+    const double area = (hi_u - lo_u) * (hi_v - lo_v);
+    if (area < best_area - 1e-12) best_area = area, best_yaw = std::atan2(uz, ux);
+  }
+  return std::fmod(std::fmod(best_yaw, M_PI / 2) + M_PI / 2, M_PI / 2);
+}
+
+Pose unturn_by(double yaw) {
+  Pose unturn = Pose::Identity();
+  // About y, +yaw takes the direction at atan2(z, x) = yaw to the x axis.
+  unturn.linear() = Eigen::AngleAxisd(yaw, Vec3::UnitY()).toRotationMatrix();
+  return unturn;
+}
+
+std::vector<Grasp> turned_grasps_for(const Eigen::AlignedBox3d& turned_box, double yaw, const Pose& final_pose,
+                                     const Vec3& direction, const fb::GripperGeometry& gripper) {
+  // A grasp's pose in the part's frame is the same in either world.
+  const Pose unturn = unturn_by(yaw);
+  std::vector<Grasp> out = grasps_for(turned_box, unturn * final_pose, unturn.linear() * direction, gripper);
+  const std::string turn = ", turned " + std::to_string(std::lround(yaw * 180 / M_PI)) + " deg";
+  for (Grasp& g : out) g.label += turn;
   return out;
 }
 

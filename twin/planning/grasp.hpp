@@ -28,4 +28,20 @@ struct Grasp {
 std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_pose, const Vec3& direction,
                               const fb::GripperGeometry& gripper);
 
+// The turn about the vertical (y) that lines a part's footprint up with the axes: the angle in
+// [0, pi/2) of the smallest rectangle around the points' (x, z), which lies along an edge of
+// their convex hull. A part that stands turned (a stool's leg at 30 degrees) is held across its
+// own faces in the frame turned so, where the grasps on its box in the world's axes close on
+// its corners.
+double footprint_yaw(const std::vector<Vec3>& points);
+
+// The rotation that takes the world to the world turned by -yaw about y, where a footprint at
+// `yaw` lies along the axes.
+Pose unturn_by(double yaw);
+
+// grasps_for on `turned_box`, the part's box in the world turned by unturn_by(yaw), the
+// gripper turned with it; each label says the turn ("across x from above, turned 30 deg").
+std::vector<Grasp> turned_grasps_for(const Eigen::AlignedBox3d& turned_box, double yaw, const Pose& final_pose,
+                                     const Vec3& direction, const fb::GripperGeometry& gripper);
+
 }  // namespace twin
