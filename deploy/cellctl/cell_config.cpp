@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
@@ -193,6 +194,26 @@ void read_discovery(const std::filesystem::path& file, const YAML::Node& root, C
   }
 }
 
+// yaml-cpp keeps the first of two equal keys in a map and drops the second without a word: a
+// second `gripper:` would be ignored. Refused, with both lines.
+void no_repeated_keys(const std::filesystem::path& file, const YAML::Node& node) {
+  if (node.IsSequence()) {
+    for (const auto& item : node) no_repeated_keys(file, item);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::map<std::string, int> seen;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.Scalar();
+    const auto [it, first] = seen.emplace(key, entry.first.Mark().line + 1);
+    if (!first) {
+      throw ConfigError(where(file, entry.first) + ": the key '" + key + "' is given twice (first on line " +
+                        std::to_string(it->second) + ")");
+    }
+    no_repeated_keys(file, entry.second);
+  }
+}
+
 }  // namespace
 
 CellConfig read_cell_config(const std::filesystem::path& file) {
@@ -205,6 +226,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
     throw ConfigError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   if (!root.IsMap()) throw ConfigError(file.string() + ": a cell is a map of keys");
+  no_repeated_keys(file, root);
   CellConfig c;
   c.file = file;
   known_keys(file, root,

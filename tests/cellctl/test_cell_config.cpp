@@ -129,3 +129,10 @@ TEST_CASE("deployment: operators are names of their own (their certificates' too
     CHECK_THROWS_WITH(cell_with("operators: [" + taken + "]\n"), Catch::Contains("has the name of"));
   }
 }
+
+TEST_CASE("deployment: a key given twice is refused with both lines, not the second dropped", "[cellctl][config]") {
+  CHECK_THROWS_WITH(cell_with("gripper:\n  max_opening: 0.1\ngripper:\n  max_opening: 0.3\n"),
+                    Catch::Contains(":4: the key 'gripper' is given twice (first on line 2)"));
+  CHECK_THROWS_WITH(cell_with("gripper:\n  max_opening: 0.1\n  max_opening: 0.3\n"),
+                    Catch::Contains(":4: the key 'max_opening' is given twice (first on line 3)"));
+}
