@@ -3,6 +3,10 @@
 
 #include <signal.h>
 
+#include <fstream>
+#include <string>
+#include <vector>
+
 #include <catch2/catch.hpp>
 
 #include "services/state/cell_store.hpp"
@@ -87,6 +91,57 @@ TEST_CASE("cellctl up ends and restarts a process that runs but is not heard (a 
   bool journaled = false;
   for (const auto& e : state::CellStore(dir / "state").journal_since(0)) journaled |= e.event == "unheard" && e.source == "buffer-2";
   CHECK(journaled);
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
+  CHECK(up.wait_for_exit(30s) == 0);
+}
+
+TEST_CASE("cellctl up with two discovery servers: one killed is started again, and while one is stopped new twins and "
+          "clients find the cell through the other",
+          "[process][cell][discovery]") {
+  const fs::path dir = test::scratch("two-servers");
+  const std::string domain = "206";
+  const fs::path cell = dir / "cell.yaml", log = dir / "up.log";
+  std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\ndiscovery: {servers: [127.0.0.1:12406, 127.0.0.1:12407]}\n";
+  test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain, "--real-time-factor", "50", "--state-dir",
+                         (dir / "state").string()},
+                        log.string());
+  REQUIRE(test::appears(log, "cell up on domain"));
+  // The first server: the child whose command line has `--serve 0`.
+  const auto server_0 = [&] {
+    for (const auto& [name, pid] : test::children_of(up.pid())) {
+      std::ifstream in("/proc/" + std::to_string(pid) + "/cmdline", std::ios::binary);
+      std::vector<std::string> args;
+      for (std::string arg; std::getline(in, arg, '\0');) args.push_back(arg);
+      for (std::size_t i = 0; i + 1 < args.size(); ++i) {
+        if (args[i] == "--serve" && args[i + 1] == "0") return pid;
+      }
+    }
+    return pid_t{0};
+  };
+  const auto order = [&](const std::string& product, const std::string& id) {
+    const int code = test::cellctl({"submit", std::string(PRODUCTS_DIR) + "/" + product, "--domain", domain, "--order", id,
+                                    "--out", (dir / id).string()},
+                                   dir / (id + ".log"));
+    INFO(test::read_text(dir / (id + ".log")) << test::read_text(log));
+    CHECK(code == 0);
+  };
+
+  const pid_t killed = server_0();
+  REQUIRE(killed > 0);
+  ::kill(killed, SIGKILL);
+  REQUIRE(test::appears(log, "discovery-0 ended (exit 137); restarting it"));
+  REQUIRE(test::appears(log, "discovery-0 restarted"));
+  order("lego-tower/lego-tower.aml", "after-kill");
+
+  // Stopped, not ended: the cell runs on through the other server. Two orders, so that the
+  // second is taken by a twin started while the first server was stopped.
+  const pid_t stopped = server_0();
+  REQUIRE(stopped > 0);
+  REQUIRE(stopped != killed);
+  ::kill(stopped, SIGSTOP);
+  order("lego-tower/lego-tower.aml", "stopped-1");
+  order("cranfield/cranfield.aml", "stopped-2");
+  ::kill(stopped, SIGCONT);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
   CHECK(up.wait_for_exit(30s) == 0);
 }
