@@ -213,3 +213,36 @@ TEST_CASE("cancel: a queued order never starts, one in physical assembly fails w
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
   CHECK(up.wait_for_exit(30s) == 0);
 }
+
+TEST_CASE("cancel: an order whose twin is still planning ends within seconds of the ask, not when its planning would",
+          "[process][cell][desk]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("cancel-planning"), state = dir / "state";
+  const std::string domain = "207";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir", state.string()},
+                        (dir / "up.log").string());
+  REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+  // A real box whose planning takes half a minute in Release (every orientation searched to
+  // its end: docs/performance.md), far longer under a sanitizer.
+  const std::string product = std::string(REAL_DATA_DIR) + "/ikea-box_ivar_0666/ikea-box_ivar_0666.aml";
+  REQUIRE(test::cellctl({"submit", "--detach", product, "--domain", domain, "--order", "p1", "--out", (dir / "p1").string()},
+                        dir / "p1.log", 30s) == 0);
+  REQUIRE(journaled(state, "twin started", "p1", 30s));
+  std::this_thread::sleep_for(2s);  // well into its planning
+  const auto asked = std::chrono::steady_clock::now();
+  REQUIRE(test::cellctl({"cancel", "p1", "--domain", domain}, dir / "cancel.log", 30s) == 0);
+  state::OrderRecord p1;
+  for (auto until = asked + 60s; std::chrono::steady_clock::now() < until && !p1.ended(); std::this_thread::sleep_for(100ms)) {
+    for (const auto& o : state::CellStore(state).orders()) {
+      if (o.order == "p1") p1 = o;
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+  INFO(test::error_lines(test::read_text(dir / "up.log")) << "ended " << seconds << " s after the ask");
+  REQUIRE(p1.ended());
+  CHECK(p1.state == "FAILED");
+  // A twin that heard the ask only after planning would end with what planning found.
+  CHECK(p1.reason == "cancelled by the operator (cellctl)");
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 60s) == 0);
+  CHECK(up.wait_for_exit(30s) == 0);
+}

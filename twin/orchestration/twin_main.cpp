@@ -145,7 +145,10 @@ class TwinProcess {
     twin::PlannerOptions planning;
     planning.gripper = options_.gripper;
     planning.fixtures = options_.fixtures;
+    planning.stop = [this] { return !running || cancel_asked(); };
     twin::OrientedPlan oriented = plan_order(*loaded, *path, planning);
+    if (!running) return end_with(1, "stopped while it was planned");
+    if (!cancelled_by_.empty()) return end_with(1, "cancelled by " + cancelled_by_);
     const twin::LoadedProduct& product = oriented.product;  // as the cell builds it
     const twin::Plan& plan = oriented.plan;
     std::filesystem::create_directories(options_.out);
@@ -160,6 +163,22 @@ class TwinProcess {
   }
 
  private:
+  // Whether the operator asked to cancel the order (cellctl cancel, the dashboard): the cell's
+  // state is read at most once a second, and a read the busy database refused is tried at the
+  // next. Sets cancelled_by_.
+  bool cancel_asked() {
+    if (!cancelled_by_.empty()) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (!store_ || now - cancel_looked_at_ < std::chrono::seconds(1)) return false;
+    cancel_looked_at_ = now;
+    try {
+      cancelled_by_ = store_->cancel_requested(options_.order);
+    } catch (const state::StoreError& e) {
+      std::cerr << "order " << options_.order << ": " << e.what() << '\n';
+    }
+    return !cancelled_by_.empty();
+  }
+
   // A twin taking up an order whose physical assembly had begun follows the order its
   // predecessor stored (the parts in place were put in by it); where that no longer plans
   // (another cell-sim, another build), it plans anew and the journal says so.
@@ -437,7 +456,7 @@ class TwinProcess {
                              " s: is the cell up on domain " + std::to_string(options_.dds.domain_id) + "?");
     }
     r.post("orchestrator", "START");
-    auto last_tick = std::chrono::steady_clock::now(), last_look = last_tick;
+    auto last_tick = std::chrono::steady_clock::now();
     bool cancelled = false;
     while (!finished && running) {
       r.wait_and_run_one(std::chrono::milliseconds(50));
@@ -447,17 +466,9 @@ class TwinProcess {
         r.post("orchestrator", "TICK");
         r.post("negotiator", "TICK");
       }
-      // Whether the operator cancelled the order (cellctl cancel, the dashboard): once a second.
-      if (store_ && !cancelled && now - last_look > std::chrono::seconds(1)) {
-        last_look = now;
-        try {
-          if (const std::string who = store_->cancel_requested(options_.order); !who.empty()) {
-            cancelled = true;
-            r.post("orchestrator", "STOP", {{"reason", "cancelled by " + who}});
-          }
-        } catch (const state::StoreError& e) {  // the database busy past its retries: asked again in a second
-          std::cerr << "order " << options_.order << ": " << e.what() << '\n';
-        }
+      if (!cancelled && cancel_asked()) {
+        cancelled = true;
+        r.post("orchestrator", "STOP", {{"reason", "cancelled by " + cancelled_by_}});
       }
     }
     services::ExitWatchdog watchdog(std::chrono::seconds(30));  // ends us if the DDS entities' teardown hangs
@@ -494,6 +505,8 @@ class TwinProcess {
   std::unique_ptr<dds::Writer<cell::OrderResult, cell::OrderResultPubSubType>> result_;
   std::vector<std::function<void()>> starters_;
   std::unique_ptr<state::CellStore> store_;  // the cell's durable state, if it keeps one
+  std::string cancelled_by_;                  // who asked to cancel the order, once read (cancel_asked)
+  std::chrono::steady_clock::time_point cancel_looked_at_{};
   twin::Resume resume_;
   std::string stored_state_;
 };

@@ -183,8 +183,13 @@ class Search {
 
   double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
 
-  // Past the time limit the search stops where it stands (the report says so).
+  // Past the time limit, or when asked to stop, the search stops where it stands (the report
+  // says so).
   bool out_of_time() {
+    if (options_.stop && options_.stop()) {
+      stopped_ = told_to_stop_ = true;
+      return true;
+    }
     if (options_.time_limit <= 0 || seconds() < options_.time_limit) return false;
     stopped_ = timed_out_ = true;
     return true;
@@ -509,6 +514,10 @@ class Search {
                                     "parts it had in place",
                                 {}});
     }
+    if (told_to_stop_ && !plan_.complete) {
+      plan_.findings.push_back({"gave-up", "the search was told to stop after " + std::to_string(plan_.backtracks) +
+                                               " backtracks; the plan holds the most parts it had in place", {}});
+    }
     if (!plan_.complete) {
       std::vector<bool> in(assembled_.size(), false);
       for (const auto& s : plan_.steps) in[s.part] = true;
@@ -587,6 +596,7 @@ class Search {
   KnownCollisions known_;                                            // grasps' collisions that recur
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   bool timed_out_ = false;
+  bool told_to_stop_ = false;
   std::map<PartIndex, Instability> falls_;          // the last group each part would have made fall
 };
 
@@ -706,7 +716,8 @@ Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, Path
     plan = search.run();
     const double left =
         options.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!plan.complete && search.refused_for_gravity() && (options.time_limit <= 0 || left > 0)) {
+    const bool stopped = options.stop && options.stop();
+    if (!plan.complete && search.refused_for_gravity() && (options.time_limit <= 0 || left > 0) && !stopped) {
       Plan fixtures = plan_with_fixtures(product, sequence, path, options, stability, options.time_limit <= 0 ? 0 : left);
       if (fixtures.complete || fixtures.steps.size() > plan.steps.size()) plan = std::move(fixtures);
     }

@@ -98,6 +98,9 @@ struct PlannerOptions {
   // holds the most parts so far and says why.
   double time_limit = 0;
   std::function<void(const PlanProgress&)> progress;  // told as the search goes, when set
+  // Asked as the search goes, between its steps (often: keep it cheap); true ends it where it
+  // stands, as the time limit does (the order was cancelled, the process is asked to end).
+  std::function<bool()> stop;
   // Planning on from a partial assembly (virtual assembly has done these steps; they stand),
   // with `not_next` barred from being the next part after them (cell-sim found no path for
   // it there): the twin's way back to sequence planning.

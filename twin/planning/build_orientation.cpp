@@ -77,6 +77,10 @@ OrientedPlan plan_in_build_orientation(const LoadedProduct& product, SequencePla
   OrientedPlan best = std::move(finished);
   std::vector<std::string> tried{"parts in place " + best.orientation.name + ": " + parts_in(best.plan, parts)};
   for (std::size_t i = 1; i < orientations.size(); ++i) {
+    if (options.stop && options.stop()) {
+      tried.push_back(orientations[i].name + ": not tried, planning was told to stop");
+      break;
+    }
     PlannerOptions each = options;
     if (options.time_limit > 0) {
       each.time_limit = options.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
