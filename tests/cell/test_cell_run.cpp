@@ -37,6 +37,21 @@ std::vector<json> read_events(const fs::path& file) {
   return out;
 }
 
+// `cellctl run` of one order ("order-1") of `product` on the default cell with one buffer that
+// holds `stock` (YAML: "{bolt: 2, nut: 2}"), at 50x: DIR/cell.yaml, cellctl.log, events.jsonl,
+// out/. The exit code.
+int run_one_order(const fs::path& dir, const std::string& stock, const std::string& product, const std::string& domain) {
+  std::string cell = read_text(std::string(DEPLOY_CELLS) + "/default.yaml");
+  cell = cell.substr(0, cell.find("buffers:")) + "buffers:\n  - id: buffer-1\n    position: [2.0, 0, -0.8]\n    stock: " + stock +
+         "\n";
+  fs::create_directories(dir);
+  { std::ofstream(dir / "cell.yaml") << cell; }
+  test::clean_stale_dds_segments();
+  return cellctl({"run", "--cell", (dir / "cell.yaml").string(), product, "--domain", domain, "--real-time-factor", "50",
+                  "--events", (dir / "events.jsonl").string(), "--out", (dir / "out").string(), "--order", "order-1"},
+                 dir / "cellctl.log");
+}
+
 // The part's name from its body id: "ORDER/NAME" or "ORDER/virtual/NAME".
 std::string part_name(const std::string& body) { return body.substr(body.rfind('/') + 1); }
 bool is_virtual(const std::string& body) { return body.find("/virtual/") != std::string::npos; }
@@ -243,16 +258,8 @@ TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "
 // Hidden: ctest runs it as cell_run_screw (tests/CMakeLists.txt), skipped under the sanitizers.
 TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm operation of its own", "[.screw][process][cell]") {
   const fs::path dir = scratch("screw");
-  std::string cell = read_text(std::string(DEPLOY_CELLS) + "/default.yaml");
-  cell = cell.substr(0, cell.find("buffers:")) +
-         "buffers:\n  - id: buffer-1\n    position: [2.0, 0, -0.8]\n    stock: {bolt: 2, nut: 2}\n";
-  fs::create_directories(dir);
-  { std::ofstream(dir / "cell.yaml") << cell; }
-  test::clean_stale_dds_segments();
-  const int code = cellctl({"run", "--cell", (dir / "cell.yaml").string(), std::string(REAL_DATA_DIR) +
-                            "/factory-nut-bolt-m12/factory-nut-bolt-m12.aml", "--domain", "203", "--real-time-factor", "50",
-                            "--events", (dir / "events.jsonl").string(), "--out", (dir / "out").string(), "--order", "order-1"},
-                           dir / "cellctl.log");
+  const int code =
+      run_one_order(dir, "{bolt: 2, nut: 2}", std::string(REAL_DATA_DIR) + "/factory-nut-bolt-m12/factory-nut-bolt-m12.aml", "203");
   INFO(read_text(dir / "cellctl.log"));
   REQUIRE(code == 0);
   const json plan = json::parse(read_text(dir / "out" / "plan.json"));
@@ -280,16 +287,8 @@ TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm opera
 
 TEST_CASE("cell run: a table whose pin goes in from below is built upside down and delivered so", "[process][cell]") {
   const fs::path dir = scratch("upside-down");
-  std::string cell = read_text(std::string(DEPLOY_CELLS) + "/default.yaml");
-  cell = cell.substr(0, cell.find("buffers:")) +
-         "buffers:\n  - id: buffer-1\n    position: [2.0, 0, -0.8]\n    stock: {Plate: 1, Leg: 4, Pin: 1}\n";
-  fs::create_directories(dir);
-  { std::ofstream(dir / "cell.yaml") << cell; }
-  test::clean_stale_dds_segments();
-  const int code = cellctl({"run", "--cell", (dir / "cell.yaml").string(), std::string(TEST_DATA_DIR) +
-                            "/planning/upside-down/table-with-pin.aml", "--domain", "204", "--real-time-factor", "50",
-                            "--events", (dir / "events.jsonl").string(), "--out", (dir / "out").string(), "--order", "order-1"},
-                           dir / "cellctl.log");
+  const int code = run_one_order(dir, "{Plate: 1, Leg: 4, Pin: 1}",
+                                 std::string(TEST_DATA_DIR) + "/planning/upside-down/table-with-pin.aml", "204");
   INFO(read_text(dir / "cellctl.log"));
   REQUIRE(code == 0);
   const json plan = json::parse(read_text(dir / "out" / "plan.json"));
