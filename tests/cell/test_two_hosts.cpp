@@ -10,6 +10,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
 
 #define CATCH_CONFIG_RUNNER
 #include <catch2/catch.hpp>
@@ -101,6 +104,56 @@ TEST_CASE("two hosts: an OEM in one network namespace submits Cranfield to a sec
   CHECK(test::read_text(dir / "submit.log").find("assembled 9 parts") != std::string::npos);
 
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("two hosts: a discovery server on each; the OEM host's server killed while its order is under way, the "
+          "order goes on and the next finds the cell through the other",
+          "[process][network][discovery]") {
+  test::clean_stale_dds_segments();
+  TwoHosts hosts;
+  REQUIRE(hosts.ok());
+  const Net& n = hosts.net();
+  const fs::path dir = test::scratch("two-hosts-servers");
+  const std::string domain = "208", port = std::to_string(11811 + 208);
+  const fs::path cell = dir / "cell.yaml", state = dir / "state";
+  std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nnetwork: {interfaces: [" << n.cell_ip << "], peers: [" << n.oem_ip
+                      << "]}\ndiscovery: server\n";
+  // The cell's host runs its server (number 0: the servers are numbered by address); the OEM's
+  // host, with no cellctl up of its own, runs the other by hand.
+  test::ChildProcess up({"/usr/sbin/ip", "netns", "exec", n.cell_ns, CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain,
+                         "--real-time-factor", "20", "--state-dir", state.string()},
+                        (dir / "up.log").string());
+  const std::vector<std::string> servers{"--discovery-server", n.cell_ip + ":" + port, "--discovery-server", n.oem_ip + ":" + port};
+  std::vector<std::string> server_argv{"/usr/sbin/ip", "netns", "exec", n.oem_ns, DISCOVERY_SERVER_EXE, "--domain", domain,
+                                       "--serve", "1", "--interface", n.oem_ip, "--peer", n.cell_ip};
+  server_argv.insert(server_argv.end(), servers.begin(), servers.end());
+  test::ChildProcess oem_server(server_argv, (dir / "oem-server.log").string());
+  {
+    INFO(test::read_text(dir / "up.log"));
+    REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+  }
+  const auto submit = [&](const std::string& id) {
+    std::vector<std::string> argv{"/usr/sbin/ip", "netns", "exec", n.oem_ns, CELLCTL_EXE, "submit",
+                                  std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain", domain, "--state-dir",
+                                  state.string(), "--interface", n.oem_ip, "--peer", n.cell_ip, "--order", id, "--out",
+                                  (dir / id).string()};
+    argv.insert(argv.end(), servers.begin(), servers.end());
+    return std::make_unique<test::ChildProcess>(argv, (dir / (id + ".log")).string());
+  };
+  // Once the first order is under way, the OEM host's server dies.
+  auto first = submit("first");
+  REQUIRE(test::appears(dir / "first.log", "PHYSICAL_ASSEMBLY", 120s));
+  oem_server.kill_hard();
+  const int first_code = first->wait_for_exit(180s);
+  auto second = submit("second");
+  const int second_code = second->wait_for_exit(180s);
+  INFO(test::read_text(dir / "first.log") << test::read_text(dir / "second.log") << test::read_text(dir / "up.log"));
+  CHECK(first_code == 0);
+  CHECK(second_code == 0);
+  CHECK(test::read_text(dir / "second.log").find("assembled") != std::string::npos);
+
+  CHECK(test::cellctl({"down", "--domain", domain, "--state-dir", state.string()}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }
 
