@@ -7,6 +7,7 @@
 #include "tests/support/generated_products.hpp"
 #include "twin/planning/build_orientation.hpp"
 #include "twin/planning/path_planner.hpp"
+#include "twin/report/html_report.hpp"
 
 namespace {
 
@@ -85,6 +86,9 @@ TEST_CASE("build orientation: a table with a pin put in from below is planned up
   REQUIRE(said != oriented.plan.findings.end());
   CHECK_THAT(said->message, Catch::Contains("built upside down") && Catch::Contains("parts in place as finished: 5 of 6") &&
                                 Catch::Contains("delivered upside down"));
+  // The designer's report says it at the top.
+  CHECK_THAT(twin::html_report(oriented.product, oriented.plan),
+             Catch::Contains("6 of 6 parts in 6 steps, built upside down (and delivered so); sequence"));
 }
 
 TEST_CASE("build orientation: a product that goes together as it stands is not turned", "[planning][orientation]") {

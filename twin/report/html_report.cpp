@@ -206,7 +206,9 @@ std::string html_report(const LoadedProduct& loaded, const Plan& plan, const Rep
        << escape(product.name()) << (options.title.empty() ? "" : " <small>" + escape(options.title) + "</small>")
        << "</h1>\n<p class=\"summary " << (plan.complete ? "complete" : "incomplete") << "\">"
        << (plan.complete ? "Complete" : "INCOMPLETE") << ": " << placed << " of " << product.parts().size()
-       << " parts in " << plan.steps.size() << " steps; sequence " << escape(plan.sequence_planner) << ", path "
+       << " parts in " << plan.steps.size() << " steps"
+       << (plan.orientation == "as finished" ? "" : ", built " + escape(plan.orientation) + " (and delivered so)")
+       << "; sequence " << escape(plan.sequence_planner) << ", path "
        << escape(plan.path_planner) << "; " << plan.backtracks << " backtracks; least insertion margin "
        << fixed(least_margin(plan.steps, plan.margin_reach) * 1000, 2) << " mm; " << plan.findings.size()
        << " findings.</p>\n"
