@@ -60,6 +60,21 @@ TEST_CASE("build orientation: a product turned upside down stands on the station
   CHECK(world_box(finished, plate).min().y() == Approx(0.04).margin(1e-9));
 }
 
+TEST_CASE("build orientation: each side is named by the face of the finished product that lies on the station",
+          "[planning][orientation]") {
+  const twin::LoadedProduct finished = table_with_pin_from_below();
+  const auto leg = *finished.product.find_part("leg4");  // at +x, +z
+  const auto plate = *finished.product.find_part("plate");
+  for (const auto& o : twin::build_orientations()) {
+    INFO(o.name);
+    const twin::LoadedProduct turned = twin::turned_product(finished, o.turn);
+    const Eigen::AlignedBox3d leg_box = world_box(turned, leg), plate_box = world_box(turned, plate);
+    if (o.name == "on its +x side" || o.name == "on its +z side") CHECK(leg_box.min().y() < plate_box.center().y());
+    if (o.name == "on its -x side" || o.name == "on its -z side") CHECK(leg_box.min().y() > plate_box.center().y());
+    if (o.name == "upside down") CHECK(plate_box.min().y() == Approx(0).margin(1e-9));
+  }
+}
+
 TEST_CASE("build orientation: a table with a pin put in from below is planned upside down, complete and verified",
           "[planning][orientation]") {
   const twin::LoadedProduct product = table_with_pin_from_below();

@@ -32,14 +32,15 @@ std::string parts_in(const Plan& plan, std::size_t parts) {
 }  // namespace
 
 const std::vector<BuildOrientation>& build_orientations() {
-  // Y is up; a turn of 90 degrees about z lays the product's +x side down, about x its -z side.
+  // Y is up; a turn of 90 degrees about z takes +x up, so the product lies on its -x side;
+  // 90 degrees about x takes +z down.
   static const std::vector<BuildOrientation> all{
       {"as finished", Quat::Identity()},
       {"upside down", about(Vec3::UnitX(), 180)},
-      {"on its +x side", about(Vec3::UnitZ(), 90)},
-      {"on its -x side", about(Vec3::UnitZ(), -90)},
-      {"on its -z side", about(Vec3::UnitX(), 90)},
-      {"on its +z side", about(Vec3::UnitX(), -90)},
+      {"on its -x side", about(Vec3::UnitZ(), 90)},
+      {"on its +x side", about(Vec3::UnitZ(), -90)},
+      {"on its +z side", about(Vec3::UnitX(), 90)},
+      {"on its -z side", about(Vec3::UnitX(), -90)},
   };
   return all;
 }
