@@ -161,3 +161,56 @@ TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers i
   CHECK(changed.wait_for(lock, std::chrono::seconds(20), [&] { return got.size() >= sent.size(); }));
   CHECK(got == sent);
 }
+
+TEST_CASE("a reader filtered by a field gets the samples whose field it names, and only those", "[dds]") {
+  const dds::ParticipantSettings settings{177, true, {}};
+  auto station = dds::make_participant("test-station", settings);
+  auto twin_a = dds::make_participant("test-twin-a", settings);
+  auto twin_b = dds::make_participant("test-twin-b", settings);
+  const auto from_order = [](const cell::CommandEvent& e) {
+    return fb::Data{{"command_id", e.command_id().to_string()}, {"order", e.order_id().to_string()}};
+  };
+
+  fb::Resource resource("r", 64);
+  auto& pub = resource.add(std::make_unique<EventPublisher>("pub", station, "cell/command_events", dds::TopicKind::events,
+                                                            [](const fb::Data& d) {
+                                                              cell::CommandEvent e = to_event(d);
+                                                              e.order_id(fb::get<std::string>(d, "order"));
+                                                              return e;
+                                                            }));
+  auto& a = resource.add(std::make_unique<EventSubscriber>("a", twin_a, "cell/command_events", dds::TopicKind::events,
+                                                           from_order, dds::only_where("order_id", {"order-a"})));
+  fb::Resource other("other", 64);  // a recorder each
+  auto& both = other.add(std::make_unique<EventSubscriber>("both", twin_b, "cell/command_events", dds::TopicKind::events,
+                                                           from_order, dds::only_where("order_id", {"order-a", "order-b"})));
+  auto& got_a = resource.add(std::make_unique<fb::EventRecorder>(a));
+  auto& got_both = other.add(std::make_unique<fb::EventRecorder>(both));
+  resource.connect("a", "IND", "recorder", "IND");
+  other.connect("both", "IND", "recorder", "IND");
+  a.start();
+  both.start();
+  REQUIRE(pub.writer().wait_for_readers(2, std::chrono::seconds(10)));
+
+  for (const char* order : {"order-b", "order-c", "order-a", "order-c", "order-b"}) {
+    resource.post("pub", "REQ", {{"command_id", std::string("c-") + order}, {"t", 1.0}, {"order", std::string(order)}});
+  }
+  resource.post("pub", "REQ", {{"command_id", std::string("last")}, {"t", 1.0}, {"order", std::string("order-a")}});
+  REQUIRE(run_until(resource, got_a, 2));
+  REQUIRE(run_until(other, got_both, 4));
+  const auto orders = [](const fb::EventRecorder& r) {
+    std::vector<std::string> out;
+    for (const auto& e : r.events) out.push_back(fb::get<std::string>(e.data, "order"));
+    return out;
+  };
+  CHECK(orders(got_a) == std::vector<std::string>{"order-a", "order-a"});
+  CHECK(orders(got_both) == std::vector<std::string>{"order-b", "order-a", "order-b", "order-a"});
+}
+
+TEST_CASE("a filter on a field the type does not have is refused, naming the field", "[dds]") {
+  auto twin = dds::make_participant("test-twin", dds::ParticipantSettings{177, true, {}});
+  const auto nothing = [](const cell::CommandEvent&) { return fb::Data{}; };
+  CHECK_THROWS_WITH((dds::Reader<cell::CommandEvent, cell::CommandEventPubSubType>(
+                        twin, "cell/command_events", dds::TopicKind::events, nothing, {},
+                        dds::only_where("requester", {"arm-1"}))),
+                    Catch::Contains("cannot filter cell/command_events by its field requester"));
+}

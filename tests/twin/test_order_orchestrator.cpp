@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <thread>
 
 #include <catch2/catch.hpp>
 
@@ -32,11 +33,13 @@ class Outbox : public fb::FunctionBlock {
 
 struct Twin {
   Twin(const twin::LoadedProduct& product, const twin::Plan& plan, bool quote_only = false,
-       twin::Resume resume = {}, std::chrono::milliseconds resend_after = std::chrono::seconds(2))
+       twin::Resume resume = {}, std::chrono::milliseconds resend_after = std::chrono::seconds(2),
+       std::chrono::milliseconds wait_timeout = std::chrono::seconds(30))
       : resource("twin", 4096) {
     twin::OrderSettings order;
     order.order_id = "o1";
     order.resend_after = resend_after;
+    order.wait_timeout = wait_timeout;
     order.quote_only = quote_only;
     order.resume = std::move(resume);
     fb::NegotiationSettings negotiation;
@@ -86,6 +89,8 @@ struct Cell {
   std::function<std::string(const Data&)> refuse = [](const Data&) { return std::string(); };
   std::function<std::string(const Data&)> refuse_call = [](const Data&) { return std::string(); };  // a CFP
   std::function<bool(const Data&)> busy = [](const Data&) { return false; };  // cell-sim's queue full
+  std::function<bool(const Data&)> silent = [](const Data&) { return false; };  // cell-sim never answers it
+  std::chrono::milliseconds tick_pause{0};  // wall time before each of the orchestrator's TICKs
   std::function<bool(const fb::Event&)> stop_before = [](const fb::Event&) { return false; };  // the operator cancels
   long ahead = 0;
   std::string turns_ours = "station-1";
@@ -119,6 +124,7 @@ Outcome run(Twin& t, const Cell& cell) {
     }
     if (pending.empty() && !out.finished && ticks_left > 0) {
       --ticks_left;
+      std::this_thread::sleep_for(cell.tick_pause);
       pending = t.send("orchestrator", "TICK");
       continue;
     }
@@ -166,6 +172,7 @@ Outcome run(Twin& t, const Cell& cell) {
       out.order.push_back("SIM " + kind);
       if (kind == "spawn") out.spawned.push_back(get<std::string>(e.data, "body_id"));
       if (kind == "move") out.moves.push_back(e.data);
+      if (cell.silent(e.data)) continue;
       if (cell.busy(e.data)) {
         more = t.send("orchestrator", "SIM_REPLY",
                       {{"request_id", e.data.at("request_id")}, {"ok", false},
@@ -448,6 +455,23 @@ TEST_CASE("orchestrator: a request cell-sim answers busy goes again at the next 
   CHECK(out.finished);
   CHECK(out.complete);
   CHECK(answered_busy->size() == 2);
+}
+
+TEST_CASE("orchestrator: a cell-sim that stops answering in virtual assembly fails the order, naming the request",
+          "[twin][orchestration]") {
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
+  Twin t(lego.product, lego.plan, false, {}, std::chrono::seconds(2), std::chrono::milliseconds(100));
+  Cell cell;
+  cell.ticks = 40;
+  cell.tick_pause = std::chrono::milliseconds(10);
+  auto moves = std::make_shared<int>(0);
+  cell.silent = [moves](const Data& request) { return get<std::string>(request, "kind") == "move" && ++*moves == 3; };
+  const Outcome out = run(t, cell);
+  CHECK(out.finished);
+  CHECK_FALSE(out.complete);
+  CHECK_THAT(out.error, Catch::Contains("cell-sim did not answer request") && Catch::Contains("(move in virtual assembly)"));
+  // Nothing physical began: no station was called for.
+  CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") == out.order.end());
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {

@@ -68,11 +68,13 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     });
   }
 
-  // cell-sim is pinged until it answers: then requests and replies both get through.
+  // cell-sim is pinged until it answers: then requests and replies both get through. Once a
+  // second: sixty twins pinging at every tick were 600 requests a second for a cell-sim that
+  // had their virtual assemblies to do, and its answers came later still.
   transition(Phase::idle, "START", Phase::waiting_cell, [this](const Data&) {
     waiting_since_ = std::chrono::steady_clock::now();
     status("PLANNING", "planned " + std::to_string(plan_.steps.size()) + " steps; waiting for a station of the cell", 0);
-    emit("SIM", sim_.ping());
+    ask_sim(sim_.ping());
   });
   transition(Phase::waiting_cell, "SIM_REPLY", Phase::waiting_cell, [this](const Data&) {
     sim_answers_ = true;
@@ -83,7 +85,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
       return fail(std::string(sim_answers_ ? "no station of the cell appeared" : "cell-sim did not answer") +
                   " within " + std::to_string(settings_.wait_timeout.count() / 1000) + " s: is the cell up?");
     }
-    if (!sim_answers_) emit("SIM", sim_.ping());
+    if (!sim_answers_ && std::chrono::steady_clock::now() - asked_sim_at_ >= std::chrono::seconds(1)) ask_sim(sim_.ping());
   });
   transition(Phase::waiting_cell, "CELL_READY", Phase::virtual_assembly, [this](const Data&) { begin_virtual(); });
 
@@ -178,7 +180,15 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
     resend_unheard();
     ask_sim_again();
   });
-  transition(Phase::virtual_assembly, "TICK", Phase::virtual_assembly, [this](const Data&) { ask_sim_again(); });
+  transition(Phase::virtual_assembly, "TICK", Phase::virtual_assembly, [this](const Data&) {
+    // Answered at once by a cell-sim that works (a virtual move takes no sim time): one that
+    // stays silent is hung or gone, and the order fails saying so instead of waiting for ever.
+    if (sim_silent()) {
+      return fail("cell-sim did not answer request " + awaited_id_ + " (" + get<std::string>(actions_.front().data, "kind") +
+                  " in virtual assembly) within " + std::to_string(settings_.wait_timeout.count() / 1000) + " s");
+    }
+    ask_sim_again();
+  });
   transition(Phase::physical, "PHYSICAL_DONE", Phase::cleanup, [this](const Data&) { plan_cleanup(); });
 
   // A failure anywhere cancels undelivered fetches (fail) and cleans up; the order's twin
@@ -663,7 +673,17 @@ void OrderOrchestrator::plan_physical() {
 void OrderOrchestrator::ask_sim_again() {
   if (!sim_busy_) return;
   sim_busy_ = false;
-  if (action_running_ && !actions_.empty() && actions_.front().kind == Action::sim) emit("SIM", actions_.front().data);
+  if (action_running_ && !actions_.empty() && actions_.front().kind == Action::sim) ask_sim(actions_.front().data);
+}
+
+void OrderOrchestrator::ask_sim(const Data& request) {
+  asked_sim_at_ = std::chrono::steady_clock::now();
+  emit("SIM", request);
+}
+
+bool OrderOrchestrator::sim_silent() const {
+  return action_running_ && !sim_busy_ && !actions_.empty() && actions_.front().kind == Action::sim &&
+         std::chrono::steady_clock::now() - asked_sim_at_ > settings_.wait_timeout;
 }
 
 void OrderOrchestrator::plan_cleanup() {
@@ -685,7 +705,7 @@ void OrderOrchestrator::next_action() {
     switch (a.kind) {
       case Action::sim:
         awaited_id_ = get<std::string>(a.data, "request_id");
-        return emit("SIM", a.data);
+        return ask_sim(a.data);
       case Action::command:
         awaited_id_ = get<std::string>(a.data, "command_id");
         return send_command(a.data);

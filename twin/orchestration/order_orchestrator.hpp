@@ -191,6 +191,8 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   std::vector<std::string> virtual_gripper() const;  // its bodies in the order's scene, the palm first
   std::vector<std::string> fetched_types() const;  // of each part a step fetches, in planned order
   bool waited_too_long() const;
+  void ask_sim(const fb::Data& request);
+  bool sim_silent() const;  // the awaited cell-sim request unanswered for wait_timeout
 
   const LoadedProduct& product_;
   Plan plan_;
@@ -202,6 +204,7 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   Script actions_;
   bool action_running_ = false;
   std::string awaited_id_;
+  std::chrono::steady_clock::time_point asked_sim_at_;  // the awaited cell-sim request went out
   bool sim_busy_ = false;
   int busy_answers_ = 0;  // in a row
   static constexpr int kMaxBusyAnswers = 300;  // at a tick each: 30 s
