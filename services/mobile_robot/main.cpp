@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     node.start(std::chrono::seconds(30), &running);
     places.start();
     give_events.start();
-    resource.post("robot", "INIT");
+    services::post_when_room(resource, "robot", "INIT");
     std::cout << "mobile-robot " << config.id << " ready on domain " << dds.domain_id << std::endl;
     services::run_until_stopped({&resource}, running);
   } catch (const std::exception& e) {

@@ -54,6 +54,19 @@ inline void exit_if_stop_hangs() {
 }
 }  // namespace detail
 
+// Queues an event of the process's own for a resource whose thread has not started (its
+// INIT): where the queue is full, it first delivers what came. Sixty twins' calls filled a
+// station's 256 while its arm's node started, and the station died of its refused INIT.
+inline void post_when_room(fb::Resource& resource, const std::string& block, const std::string& input) {
+  for (;;) {
+    try {
+      return resource.post(block, input);
+    } catch (const fb::EventQueueOverflow&) {
+      resource.run_one();
+    }
+  }
+}
+
 // The flag of run_until_signalled(), for a process's other functions.
 inline const std::atomic<bool>& running_flag() { return detail::running; }
 

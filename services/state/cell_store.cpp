@@ -7,6 +7,9 @@
 namespace state {
 namespace {
 
+// Stored in the database (user_version) once it has kSchema and every later column: one more
+// whenever either changes.
+constexpr long kSchemaVersion = 1;
 constexpr const char* kSchema = R"sql(
 CREATE TABLE IF NOT EXISTS stock(
   buffer TEXT NOT NULL, part_type TEXT NOT NULL,
@@ -154,9 +157,14 @@ CellStore::CellStore(const std::filesystem::path& dir) {
       exec("PRAGMA journal_mode=WAL");
       exec("PRAGMA synchronous=FULL");
       exec("PRAGMA foreign_keys=ON");
+      // A database that has the schema already is only read here: sixty twins opening it at
+      // once each took the write lock to create what was there, and some waited past the
+      // busy timeout ("database is locked") and failed their orders.
+      if (schema_version() == kSchemaVersion) return;
       Transaction t(*this);
       exec(kSchema);
       add_columns_of_later_versions();
+      exec(("PRAGMA user_version=" + std::to_string(kSchemaVersion)).c_str());
       t.commit();
       return;
     } catch (const StoreError&) {
@@ -175,6 +183,11 @@ CellStore::CellStore(const std::filesystem::path& dir) {
 }
 
 CellStore::~CellStore() { sqlite3_close(db_); }
+
+long CellStore::schema_version() const {
+  Statement v(db_, "PRAGMA user_version");
+  return v.step() ? v.integer(0) : 0;
+}
 
 // A database written before a column existed gets it, with its default.
 void CellStore::add_columns_of_later_versions() {

@@ -202,6 +202,7 @@ class CellStore {
   class Transaction;
   void exec(const char* sql) const;
   void add_columns_of_later_versions();
+  long schema_version() const;  // PRAGMA user_version
   // The part, on its way, goes back to the buffer it came from (within a transaction).
   void put_back(const PartRecord& part);
   std::vector<PartRecord> parts_held(const std::string& holder, Place place) const;

@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
     services::ResourceNode arm_node(arm_resource, participant, arm, arm_block, hold_arm);
     station_node.start(std::chrono::seconds(30), &running);
     arm_node.start(std::chrono::seconds(30), &running);
-    station_resource.post("station", "INIT");
+    services::post_when_room(station_resource, "station", "INIT");
     std::cout << "station " << station.id << " with arm " << arm.id << " ready on domain " << dds.domain_id
               << std::endl;
     services::run_until_stopped({&station_resource, &arm_resource}, running);

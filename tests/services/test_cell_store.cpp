@@ -411,3 +411,17 @@ TEST_CASE("SIGKILL in the middle of writing loses nothing committed and corrupts
   CHECK(peg.in_transit == static_cast<int>(store.parts("o").size()));
   CHECK(peg.initial == peg.accounted());
 }
+
+TEST_CASE("a process opens a database that has the schema while another holds the write lock", "[state]") {
+  const fs::path dir = fresh_dir("opened-while-written");
+  { state::CellStore first(dir); }  // makes the schema
+  sqlite3* writer = nullptr;
+  REQUIRE(sqlite3_open(state::CellStore::file_in(dir).c_str(), &writer) == SQLITE_OK);
+  REQUIRE(sqlite3_exec(writer, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) == SQLITE_OK);
+  // Reads only: it neither waits for the lock nor fails (it waited 10 s and failed before).
+  std::unique_ptr<state::CellStore> second;
+  CHECK_NOTHROW(second = std::make_unique<state::CellStore>(dir));
+  if (second) CHECK(second->orders().empty());
+  sqlite3_exec(writer, "ROLLBACK", nullptr, nullptr, nullptr);
+  sqlite3_close(writer);
+}

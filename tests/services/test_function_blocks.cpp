@@ -6,6 +6,7 @@
 
 #include "services/blocks/command_lifecycle.hpp"
 #include "services/blocks/contractor.hpp"
+#include "services/node/run.hpp"
 #include "services/runtime/block_test_fixture.hpp"
 
 namespace {
@@ -59,6 +60,20 @@ TEST_CASE("a resource delivers events along its connections, one at a time, in o
   CHECK(a.count == 2);
   CHECK(b.count == 2);
   CHECK(c.count == 2);
+}
+
+TEST_CASE("a process's own event for a full queue waits for room, after what came first", "[fb]") {
+  fb::Resource resource("station", 2);
+  auto& a = resource.add(std::make_unique<Counter>("a"));
+  auto& init = resource.add(std::make_unique<Counter>("init"));
+  resource.post("a", "REQ");
+  resource.post("a", "REQ");
+  services::post_when_room(resource, "init", "REQ");
+  CHECK(a.count == 1);  // one delivered to make room
+  CHECK(init.count == 0);
+  CHECK(resource.run_until_idle() == 2);
+  CHECK(a.count == 2);
+  CHECK(init.count == 1);
 }
 
 TEST_CASE("a full event queue refuses loudly and counts what it refused", "[fb]") {

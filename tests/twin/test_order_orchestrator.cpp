@@ -90,6 +90,8 @@ struct Cell {
   std::function<std::string(const Data&)> refuse_call = [](const Data&) { return std::string(); };  // a CFP
   std::function<bool(const Data&)> busy = [](const Data&) { return false; };  // cell-sim's queue full
   std::function<bool(const Data&)> silent = [](const Data&) { return false; };  // cell-sim never answers it
+  // station-1 is gone (its lease ran out) before this event, and back before the next call.
+  std::function<bool(const fb::Event&)> station_leaves = [](const fb::Event&) { return false; };
   std::chrono::milliseconds tick_pause{0};  // wall time before each of the orchestrator's TICKs
   std::function<bool(const fb::Event&)> stop_before = [](const fb::Event&) { return false; };  // the operator cancels
   long ahead = 0;
@@ -114,7 +116,7 @@ Outcome run(Twin& t, const Cell& cell) {
   capability("mobile-robot-1", "mobile-robot", "fetch", "");
   capability("buffer-1", "buffer", "give", "");
   std::vector<fb::Event> pending = t.send("orchestrator", "START");
-  bool queued_reported = false, ticked = false;
+  bool queued_reported = false, ticked = false, station_away = false;
   int ticks_left = cell.ticks;
   for (int guard = 0; guard < 100000; ++guard) {
     if (pending.empty() && !out.finished && !ticked) {
@@ -137,6 +139,15 @@ Outcome run(Twin& t, const Cell& cell) {
     }
     const fb::Event e = pending.front();
     pending.erase(pending.begin());
+    if (cell.station_leaves(e)) {
+      t.send("orchestrator", "RESOURCE_GONE", {{"resource_id", std::string("station-1")}});
+      station_away = true;
+    }
+    if (station_away && e.name == "CFP") {
+      station_away = false;
+      const auto back = capability("station-1", "station", "host", "");
+      pending.insert(pending.end(), back.begin(), back.end());
+    }
     if (cell.stop_before(e)) {
       const auto stopped = t.send("orchestrator", "STOP", {{"reason", std::string("cancelled by the operator (test)")}});
       pending.insert(pending.end(), stopped.begin(), stopped.end());
@@ -472,6 +483,22 @@ TEST_CASE("orchestrator: a cell-sim that stops answering in virtual assembly fai
   CHECK_THAT(out.error, Catch::Contains("cell-sim did not answer request") && Catch::Contains("(move in virtual assembly)"));
   // Nothing physical began: no station was called for.
   CHECK(std::find(out.order.begin(), out.order.end(), "CFP host") == out.order.end());
+}
+
+TEST_CASE("orchestrator: the station whose place virtual assembly uses leaves in the middle of it, and the order goes on",
+          "[twin][orchestration]") {
+  const test::Planned lego(test::product("lego-tower/lego-tower.aml"));
+  Twin t(lego.product, lego.plan);
+  Cell cell;
+  auto moves = std::make_shared<int>(0);
+  cell.station_leaves = [moves](const fb::Event& e) {
+    return e.name == "SIM" && get<std::string>(e.data, "kind") == "move" && ++*moves == 2;
+  };
+  const Outcome out = run(t, cell);
+  INFO(out.error);
+  CHECK(*moves > 2);
+  CHECK(out.finished);
+  CHECK(out.complete);
 }
 
 TEST_CASE("orchestrator: a failure in physical assembly cancels the fetches not yet delivered", "[twin][orchestration]") {

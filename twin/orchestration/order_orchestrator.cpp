@@ -222,7 +222,10 @@ void OrderOrchestrator::try_begin_virtual() {
       settings_.arm_speed = p.speed;
       settings_.arm_angular_speed = p.angular_speed;
     }
-    if (p.kind == "station" && virtual_station_.empty()) virtual_station_ = id;
+    if (p.kind == "station" && virtual_station_.empty()) {
+      virtual_station_ = id;
+      virtual_place_ = location(id);  // kept: that station may leave while the order assembles virtually
+    }
   }
   if (!virtual_station_.empty() && sim_answers_) raise("CELL_READY");
 }
@@ -493,7 +496,7 @@ void OrderOrchestrator::add_candidate(std::size_t step, std::size_t candidate) {
   const MeshRef& mesh = *product_.product.parts()[part].mesh;
   // Where the robot puts it down, and carried from there as the cell's arm will carry it
   // (plan_physical): the carry is checked too, not only the trajectory.
-  const Location here = location(virtual_station_);
+  const Location& here = virtual_place_;
   const Pose start = geometry_.at(here, w.front().part), standing = geometry_.at_dock(here, part, start);
   const Pose grip = w.front().part.inverse() * w.front().gripper;
   actions_.push_back({Action::sim, sim_.spawn(body, pose_numbers({standing}), {0, 0, 0}, false, mesh.file.string(), scene,
@@ -540,7 +543,7 @@ void OrderOrchestrator::add_unit_candidate(std::size_t step, const Trajectory& t
   const PlanStep& unit_step = plan_.steps[step];
   const SubassemblyPlan* unit = geometry_.subassembly_of(unit_step);
   const std::string& scene = settings_.order_id;
-  const Location here = location(virtual_station_);
+  const Location& here = virtual_place_;
   std::vector<PartIndex> members{unit_step.part};
   members.insert(members.end(), unit_step.carried.begin(), unit_step.carried.end());
   for (PartIndex member : members) {

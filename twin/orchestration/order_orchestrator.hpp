@@ -212,6 +212,7 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   std::size_t step_ = 0, candidate_ = 0;
   std::map<std::size_t, std::set<PartIndex>> barred_;  // step -> parts cell-sim refused there
   std::string virtual_station_;
+  Location virtual_place_;  // virtual_station_'s place when virtual assembly began
   bool sim_answers_ = false;
   Booking booking_;  // what was called for and awarded (or quoted)
   // hold_at's answers: station -> (what they were computed from, the hold).
