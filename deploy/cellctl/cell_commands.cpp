@@ -273,8 +273,11 @@ void check_identities_for(const CellConfig& cell, std::size_t orders) {
   }
 }
 
-// Starts a twin per order at once, or hands each order to a twin of `standby` where one
-// stands by, and follows them to their ends, printing their progress.
+// Starts a twin per order, or hands each order to a twin of `standby` where one stands by,
+// and follows them to their ends, printing their progress. At most the deployment's
+// max_twins run at once, as in `up`'s queue; the other orders wait their turn, in order.
+// (Sixty twins at once on two cores: every new twin's endpoints discovered by every other
+// process took 20-45 s, and orders failed waiting for the cell.)
 void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Order>& orders, CellObserver& observer,
                 double wait_s, TwinIdentities& identities, TwinPool* standby = nullptr) {
   std::set<std::string> ids;
@@ -282,7 +285,7 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
   observer.on_status([ids](const cell::OrderStatus& s) {
     if (ids.count(s.order_id().to_string())) print_progress(s);
   });
-  for (auto& order : orders) {
+  const auto start = [&](Order& order) {
     order.sim_start = observer.sim_now();
     // `run` gives its state folder; a submit to processes started by hand gives the file's, if any.
     if (standby) {
@@ -296,18 +299,29 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
                                                         o.sequence, o.path, cell.state_dir, wait_s))
                        .process;  // check_identities_for: there is an identity for each
     }
+  };
+  const std::size_t at_once = static_cast<std::size_t>(cell.max_twins);
+  if (orders.size() > at_once) {
+    std::cout << orders.size() - at_once << " of " << orders.size() << " orders wait for a twin (max_twins: "
+              << at_once << " at once)" << std::endl;
   }
-  for (std::size_t running = orders.size(); running > 0;) {
-    running = 0;
+  std::size_t next = 0;  // the first order not started
+  for (std::size_t running = 0;; running = 0) {
     std::vector<Process*> twins;
     for (auto& order : orders) {
-      if (order.exit_code >= 0) continue;
+      if (!order.twin || order.exit_code >= 0) continue;
       twins.push_back(order.twin.get());
       order.peak_rss_kb = std::max(order.peak_rss_kb, order.twin->peak_rss_kb());
       order.exit_code = order.twin->poll();
       running += order.exit_code < 0;
     }
-    if (stop_requested && running > 0) stop_all(twins);  // each says why it stopped, at once
+    if (stop_requested) {
+      for (; next < orders.size(); ++next) orders[next].exit_code = 1;  // never started
+      if (running > 0) stop_all(twins);  // each says why it stopped, at once
+    }
+    for (; next < orders.size() && running < at_once; ++next, ++running) start(orders[next]);
+    if (running == 0 && next == orders.size()) break;
+    if (standby) standby->tend();
     std::this_thread::sleep_for(50ms);
   }
   observer.on_status({});
@@ -724,7 +738,8 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     // A twin per order stands by while the cell comes up, as `up`'s desk keeps them: an order
     // starts in a twin that has joined the cell (docs/performance.md "Twin start-up").
     TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
-    TwinPool standby(twin_standby_argv(cell, executable_dir()), static_cast<int>(orders.size()), identities);
+    TwinPool standby(twin_standby_argv(cell, executable_dir()),
+                     static_cast<int>(std::min(orders.size(), static_cast<std::size_t>(cell.max_twins))), identities);
     RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
     std::cout << "cell up on domain " << cell.domain << ", real-time factor " << cell.real_time_factor << std::endl;
     run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities, &standby);
