@@ -32,7 +32,8 @@ struct QosSettings {
 };
 
 // A reader's settings for the samples whose `field` is one of `values`.
-inline QosSettings only_where(const std::string& field, std::vector<std::string> values, QosSettings s = {}) {
+inline QosSettings only_where(const std::string& field, std::vector<std::string> values) {
+  QosSettings s;
   s.filter_field = field;
   s.filter_values = std::move(values);
   return s;
