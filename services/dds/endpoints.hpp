@@ -28,11 +28,9 @@
 #include <fastdds/dds/core/LoanableSequence.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
-#include <fastdds/dds/topic/ContentFilteredTopic.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
-#include "services/dds/field_filter.hpp"
 #include "services/dds/participant.hpp"
 #include "services/dds/qos.hpp"
 #include "services/dds/twin_bindings.hpp"
@@ -277,16 +275,7 @@ class Reader : private fdds::DataReaderListener {
                                                                               : settings.partitions));
     check_writers_ = speaker_ && access_controlled(*participant_);
     topic_ = topic;
-    fdds::Topic* related = topic_on<PubSubType>(*participant_, topic);
-    fdds::TopicDescription* description = related;
-    if (!settings.filter_field.empty()) {
-      static std::atomic<unsigned> filters{0};  // a filtered topic's name is unique in its participant
-      filtered_ = participant_->create_contentfilteredtopic(topic + "|filtered-" + std::to_string(++filters), related,
-                                                            settings.filter_field, settings.filter_values, kFieldFilter);
-      if (!filtered_) throw std::runtime_error("cannot filter " + topic + " by its field " + settings.filter_field);
-      description = filtered_;
-    }
-    reader_ = subscriber_->create_datareader(description, reader_qos(kind, settings), this);
+    reader_ = subscriber_->create_datareader(topic_on<PubSubType>(*participant_, topic), reader_qos(kind, settings), this);
     if (!reader_) throw std::runtime_error("cannot create a reader on " + topic + refusal_reason(*participant_));
     // A binding that comes lets the samples waiting for it go on (one that came before
     // listen() too).
@@ -303,7 +292,6 @@ class Reader : private fdds::DataReaderListener {
     while (requests_ != 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     subscriber_->delete_datareader(reader_);
     participant_->delete_subscriber(subscriber_);
-    if (filtered_) participant_->delete_contentfilteredtopic(filtered_);
   }
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
@@ -469,7 +457,6 @@ class Reader : private fdds::DataReaderListener {
   std::atomic<int> requests_{0};  // drain calls not yet served
   std::atomic<bool> closed_{false};
   fdds::Subscriber* subscriber_ = nullptr;
-  fdds::ContentFilteredTopic* filtered_ = nullptr;
   fdds::DataReader* reader_ = nullptr;
 };
 

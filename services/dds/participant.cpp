@@ -19,7 +19,6 @@
 #include <fastrtps/utils/IPLocator.h>
 
 #include "cell_idl/simulationPubSubTypes.h"
-#include "services/dds/field_filter.hpp"
 #include "services/dds/twin_bindings.hpp"
 
 namespace dds {
@@ -262,7 +261,6 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
                              std::to_string(settings.domain_id));
   }
   reserve_reader_slots(*participant);
-  register_field_filter(*participant);
   return ParticipantPtr(participant, [log](DomainParticipant* p) {
     log->drop_bindings();
     p->set_listener(nullptr);

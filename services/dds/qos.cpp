@@ -40,9 +40,6 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
 DataWriterQos writer_qos(TopicKind kind, const QosSettings& settings) {
   DataWriterQos qos = DATAWRITER_QOS_DEFAULT;
   apply(qos, kind, settings);
-  // Fast DDS filters for 32 filtering readers a writer by default, and sends everything to
-  // the rest; a cell has a twin per order, and a hundred orders.
-  qos.writer_resource_limits().reader_filters_allocation.maximum = 1024;
   return qos;
 }
 

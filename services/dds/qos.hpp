@@ -25,19 +25,7 @@ struct QosSettings {
   // The DDS partitions of the endpoint's publisher or subscriber; empty: the default one
   // (a reader of an owned topic: every partition; see owned_topic()).
   std::vector<std::string> partitions;
-  // Readers: only the samples whose field `filter_field` is one of `filter_values`, filtered
-  // at the writer (field_filter.hpp). Empty: every sample.
-  std::string filter_field;
-  std::vector<std::string> filter_values;
 };
-
-// A reader's settings for the samples whose `field` is one of `values`.
-inline QosSettings only_where(const std::string& field, std::vector<std::string> values) {
-  QosSettings s;
-  s.filter_field = field;
-  s.filter_values = std::move(values);
-  return s;
-}
 
 // A resource's command topic: one reader, commanded one step at a time by the orders that
 // hired it; a flood fills this little and then waits at its sender.

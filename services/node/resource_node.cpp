@@ -409,14 +409,12 @@ ResourceNode::ResourceNode(fb::Resource& resource, dds::ParticipantPtr participa
     n.publish<cell::SimRequest, cell::SimRequestPubSubType>("sim_requests", "cell/sim/requests",
                                                             [](const fb::Data& d) { return dds::to_sim_request(d); });
     n.sim_requests = &dynamic_cast<Pub<cell::SimRequest, cell::SimRequestPubSubType>&>(resource.block("sim_requests"));
-    // Only this resource's replies (a device's, or the node's pings), filtered at cell-sim.
+    // Only this resource's replies (a device's, or the node's pings).
     const std::string me = n.config.id;
     n.subscribe<cell::SimReply, cell::SimReplyPubSubType>(
-        "sim_replies", "cell/sim/replies", TopicKind::events,
-        [me](const cell::SimReply& r) {
+        "sim_replies", "cell/sim/replies", TopicKind::events, [me](const cell::SimReply& r) {
           return r.requester() == me || r.requester() == me + "/node" ? dds::to_data(r) : fb::Data{};
-        },
-        dds::only_where("requester", {me, me + "/node"}));
+        });
     resource.connect(dev, "SIM", "sim_requests", "REQ");
     resource.connect("sim_replies", "IND", dev, "SIM_REPLY");
     resource.add(std::make_unique<fb::ActionBlock>("sim_ping", [&n](const fb::Data& reply) {

@@ -328,10 +328,8 @@ class TwinProcess {
 
   template <class T, class P>
   void subscribe(fb::Resource& r, const std::string& name, const std::string& topic, TopicKind kind,
-                 std::function<fb::Data(const T&)> to_data, const Inputs& on_sample, const Inputs& on_gone = {},
-                 const dds::QosSettings& settings = {}) {
-    auto& block =
-        r.add(std::make_unique<dds::SubscribeBlock<T, P>>(name, participant_, topic, kind, std::move(to_data), settings));
+                 std::function<fb::Data(const T&)> to_data, const Inputs& on_sample, const Inputs& on_gone = {}) {
+    auto& block = r.add(std::make_unique<dds::SubscribeBlock<T, P>>(name, participant_, topic, kind, std::move(to_data)));
     for (const auto& [to, input] : on_sample) r.connect(name, "IND", to, input);
     for (const auto& [to, input] : on_gone) r.connect(name, "GONE", to, input);
     starters_.push_back([&block] { block.start(); });
@@ -387,14 +385,14 @@ class TwinProcess {
                           {"resource_id", e.resource_id().to_string()},
                           {"state", std::string(dds::state_name(e.state()))}, {"reason", e.reason().to_string()},
                           {"sim_time", e.sim_time()}};
-        }, {{"orchestrator", "COMMAND_EVENT"}}, {}, dds::only_where("order_id", {options_.order}));
+        }, {{"orchestrator", "COMMAND_EVENT"}});
     subscribe<cell::SimReply, cell::SimReplyPubSubType>(
         r, "sim_replies", "cell/sim/replies", TopicKind::events, [this](const cell::SimReply& s) {
           if (s.requester().to_string() != options_.order) return fb::Data{};  // another requester's
           clock_.observe(s.end_time());
           if (options_.verbose) std::cout << "  sim reply " << s.request_id() << " " << s.ok() << " " << s.error() << std::endl;
           return dds::to_data(s);
-        }, {{"orchestrator", "SIM_REPLY"}}, {}, dds::only_where("requester", {options_.order}));
+        }, {{"orchestrator", "SIM_REPLY"}});
 
     publish<cell::CallForProposals, cell::CallForProposalsPubSubType>(
         r, "calls", "cell/negotiation/calls", "negotiator", "CFP", [](const fb::Data& d) { return dds::to_call(d); });
