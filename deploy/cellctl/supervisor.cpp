@@ -1,11 +1,13 @@
 #include "deploy/cellctl/supervisor.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 
 namespace cellctl {
 
 Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log log)
     : policy_(policy), log_(std::move(log)) {
+  ::setenv("NOTIFY_SOCKET", heartbeats_.name().c_str(), 1);
   for (auto& spec : specs) {
     Child child{std::move(spec), nullptr, {}, {}, 0, std::chrono::steady_clock::now()};
     child.process = std::make_unique<Process>(child.spec.name, child.spec.argv);
@@ -21,6 +23,7 @@ std::string Supervisor::tend() {
     if (c.process) {
       const int code = c.process->poll();
       if (code < 0) continue;
+      heartbeats_.forget(c.process->pid());
       c.process.reset();
       c.ends.push_back(now);
       while (!c.ends.empty() && now - c.ends.front() > policy_.window) c.ends.pop_front();
@@ -55,8 +58,18 @@ std::vector<std::string> Supervisor::end_unheard(const std::set<std::string>& he
                                                  std::chrono::steady_clock::duration silence) {
   const auto now = std::chrono::steady_clock::now();
   std::vector<std::string> ended;
+  const auto& beats = heartbeats_.beats();
   for (Child& c : children_) {
-    if (!c.process || c.spec.resources.empty()) continue;
+    if (!c.process) continue;
+    if (const auto beat = beats.find(c.process->pid()); beat != beats.end() && now - beat->second > silence) {
+      const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - beat->second).count();
+      log_(c.spec.name, "unheard", c.spec.name + " runs but its heartbeat stopped " + std::to_string(seconds) +
+                                       " s ago (its loop is stuck); ending it to restart it");
+      c.process->stop(std::chrono::seconds(2));
+      ended.push_back(c.spec.name);
+      continue;
+    }
+    if (c.spec.resources.empty()) continue;
     const bool all_heard = std::all_of(c.spec.resources.begin(), c.spec.resources.end(),
                                        [&heard](const std::string& r) { return heard.count(r) > 0; });
     if (all_heard) c.heard_at = now;

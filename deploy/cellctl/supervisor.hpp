@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/heartbeat_socket.hpp"
 #include "deploy/cellctl/processes.hpp"
 
 namespace cellctl {
@@ -22,7 +23,8 @@ class Supervisor {
  public:
   // What happened to a process ("ended", "restarted"), and the sentence for the operator.
   using Log = std::function<void(const std::string& process, const std::string& event, const std::string& message)>;
-  // Starts every process of the specs, in order.
+  // Starts every process of the specs, in order, with NOTIFY_SOCKET naming its heartbeat
+  // socket (set in this process's environment: what it starts later beats there too).
   Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log log);
   ~Supervisor();
 
@@ -32,7 +34,10 @@ class Supervisor {
   // Ends each running process one of whose resources is not in `heard` (those alive on DDS
   // now) and has not been since `silence` ago, or since the process started: a hung process
   // (seen: a buffer silent on DDS from its start, under ThreadSanitizer, that the whole cell
-  // waited for). tend() restarts it as one that died. Returns the names of those it ended.
+  // waited for). So too a process that beat its heartbeat (services::Heartbeat) and has not
+  // for `silence`: its DDS participant may look alive while its own loop is stuck (cell-sim
+  // was, in a deadlock inside Fast DDS). tend() restarts it as one that died. Returns the
+  // names of those it ended.
   std::vector<std::string> end_unheard(const std::set<std::string>& heard, std::chrono::steady_clock::duration silence);
   // Whether a process of this supervisor publishes the resource.
   bool runs(const std::string& resource) const;
@@ -51,6 +56,7 @@ class Supervisor {
 
   RestartPolicy policy_;
   Log log_;
+  HeartbeatSocket heartbeats_;
   std::vector<Child> children_;
 };
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "services/node/heartbeat.hpp"
 #include "services/node/resource_node.hpp"
 
 namespace services {
@@ -21,10 +22,15 @@ class BufferService {
  public:
   explicit BufferService(BufferConfig config);
   ~BufferService();
-  // Delivers events until `keep_running` turns false (checked every 100 ms).
+  // Delivers events until `keep_running` turns false (checked every 100 ms), beating the
+  // supervisor's heartbeat as it goes.
   template <class Flag>
   void run(const Flag& keep_running) {
-    while (keep_running) resource_.wait_and_run_one(std::chrono::milliseconds(100));
+    Heartbeat heartbeat;
+    while (keep_running) {
+      resource_.wait_and_run_one(std::chrono::milliseconds(100));
+      heartbeat.beat();
+    }
   }
 
  private:

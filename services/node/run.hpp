@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "services/node/heartbeat.hpp"
 #include "services/node/started_by.hpp"
 #include "services/runtime/resource.hpp"
 
@@ -106,12 +107,28 @@ class ExitWatchdog {
   int code_ = 1;
 };
 
+// Each resource on a thread of its own; this thread beats the heartbeat while every one of
+// them turns (a resource stuck in a call stops the beats, and its supervisor restarts us).
 inline void run_until_stopped(const std::vector<fb::Resource*>& resources, const std::atomic<bool>& running) {
+  std::vector<std::atomic<unsigned long>> turns(resources.size());
   std::vector<std::thread> threads;
-  for (fb::Resource* r : resources) {
-    threads.emplace_back([r, &running] {
-      while (running) r->wait_and_run_one(std::chrono::milliseconds(100));
+  for (std::size_t i = 0; i < resources.size(); ++i) {
+    threads.emplace_back([r = resources[i], &turn = turns[i], &running] {
+      while (running) {
+        r->wait_and_run_one(std::chrono::milliseconds(100));
+        ++turn;
+      }
     });
+  }
+  Heartbeat heartbeat;
+  std::vector<unsigned long> seen(resources.size(), 0);
+  while (running) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    bool all_turned = true;
+    for (std::size_t i = 0; i < turns.size(); ++i) all_turned &= turns[i] != seen[i];
+    if (!all_turned) continue;
+    for (std::size_t i = 0; i < turns.size(); ++i) seen[i] = turns[i];
+    heartbeat.beat();
   }
   for (auto& t : threads) t.join();
 }

@@ -120,7 +120,9 @@ int main(int argc, char** argv) {
       } catch (const fb::EventQueueOverflow&) {
       }
     };
+    services::Heartbeat heartbeat;  // cellctl up restarts a cell-sim whose loop stops turning
     while (running) {
+      heartbeat.beat();
       if (!resource.wait_and_run_one(std::chrono::milliseconds(1))) post_own("world", "TICK");
       if (store && std::chrono::steady_clock::now() - last_check > std::chrono::seconds(1)) {
         last_check = std::chrono::steady_clock::now();

@@ -1,0 +1,36 @@
+#pragma once
+// The supervisor's end of services::Heartbeat: a unix datagram socket, named to the children
+// by NOTIFY_SOCKET as systemd names its own, on which each beat's sender is known by its pid
+// (the kernel's SCM_CREDENTIALS, as systemd reads them). Abstract (no file to leave behind),
+// named after this process, so two cells on one host never share one.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <map>
+#include <string>
+
+namespace cellctl {
+
+class HeartbeatSocket {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // Binds "@agile-cell-heartbeat-<pid>"; throws std::runtime_error where it cannot.
+  HeartbeatSocket();
+  ~HeartbeatSocket();
+  HeartbeatSocket(const HeartbeatSocket&) = delete;
+  HeartbeatSocket& operator=(const HeartbeatSocket&) = delete;
+
+  // The NOTIFY_SOCKET value for a child.
+  const std::string& name() const { return name_; }
+  // Reads what came; when each pid that beat did so last.
+  const std::map<pid_t, Clock::time_point>& beats();
+  void forget(pid_t pid) { last_beat_.erase(pid); }
+
+ private:
+  int fd_ = -1;
+  std::string name_;
+  std::map<pid_t, Clock::time_point> last_beat_;
+};
+
+}  // namespace cellctl
