@@ -30,6 +30,17 @@ inline std::string read_text(const std::filesystem::path& file) {
   return s.str();
 }
 
+// The last `count` lines of a file: where a failure's message is cut short, what came last
+// (where a process stopped) is what tells.
+inline std::string last_lines(const std::filesystem::path& file, std::size_t count) {
+  const std::string text = read_text(file);
+  std::size_t at = text.size();
+  for (std::size_t n = 0; n <= count; ++n) {
+    if (at == 0 || (at = text.rfind('\n', at - 1)) == std::string::npos) return text;
+  }
+  return text.substr(at + 1);
+}
+
 // `cellctl ARGS...` to its end (bounded), output in `log`; its exit code.
 inline int cellctl(std::vector<std::string> args, const std::filesystem::path& log,
                    std::chrono::seconds timeout = std::chrono::seconds(120)) {
