@@ -471,7 +471,11 @@ class TwinProcess {
         r.post("orchestrator", "STOP", {{"reason", "cancelled by " + cancelled_by_}});
       }
     }
-    services::ExitWatchdog watchdog(std::chrono::seconds(30));  // ends us if the DDS entities' teardown hangs
+    // Ends us if the DDS entities' teardown hangs (it does, now and then, in Fast DDS 2.9.1's
+    // deadlock of a writer's reader removal against its flow controller: heartbeat.hpp). The
+    // order's results are written before it; 15 s (was 30) is what a hang costs the order's
+    // next twin, and a test that waits for the twin's end (one waited 30 s under TSan).
+    services::ExitWatchdog watchdog(std::chrono::seconds(15));
     if (!finished) return watchdog.exit(end_with(1, "stopped before the order ended"));
     if (orchestrator.take_up()) {
       // Nothing released, no final status: the cell's next twin takes the order up.
