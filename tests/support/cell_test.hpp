@@ -35,7 +35,8 @@ inline std::string read_text(const std::filesystem::path& file) {
 inline std::string last_lines(const std::filesystem::path& file, std::size_t count) {
   const std::string text = read_text(file);
   std::size_t at = text.size();
-  for (std::size_t n = 0; n <= count; ++n) {
+  if (at > 0 && text[at - 1] == '\n') --at;  // the last line's end
+  for (std::size_t n = 0; n < count; ++n) {
     if (at == 0 || (at = text.rfind('\n', at - 1)) == std::string::npos) return text;
   }
   return text.substr(at + 1);
