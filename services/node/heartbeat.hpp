@@ -15,9 +15,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
-#include <string>
 
 namespace services {
 
