@@ -42,6 +42,7 @@ std::string Supervisor::tend() {
     } else if (now >= c.restart_at) {
       try {
         c.process = std::make_unique<Process>(c.spec.name, c.spec.argv);
+        heartbeats_.forget(c.process->pid());  // a beat of an earlier process with its pid
         c.heard_at = std::chrono::steady_clock::now();
         ++c.restarts;
         log_(c.spec.name, "restarted", c.spec.name + " restarted (pid " + std::to_string(c.process->pid()) + ", restart " +
@@ -57,26 +58,24 @@ std::string Supervisor::tend() {
 std::vector<std::string> Supervisor::end_unheard(const std::set<std::string>& heard,
                                                  std::chrono::steady_clock::duration silence) {
   const auto now = std::chrono::steady_clock::now();
+  const auto seconds_since = [now](std::chrono::steady_clock::time_point t) {
+    return std::to_string(std::chrono::duration_cast<std::chrono::seconds>(now - t).count());
+  };
   std::vector<std::string> ended;
   const auto& beats = heartbeats_.beats();
   for (Child& c : children_) {
     if (!c.process) continue;
+    std::string why;  // "" while it is not hung
     if (const auto beat = beats.find(c.process->pid()); beat != beats.end() && now - beat->second > silence) {
-      const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - beat->second).count();
-      log_(c.spec.name, "unheard", c.spec.name + " runs but its heartbeat stopped " + std::to_string(seconds) +
-                                       " s ago (its loop is stuck); ending it to restart it");
-      c.process->stop(std::chrono::seconds(2));
-      ended.push_back(c.spec.name);
-      continue;
+      why = "its heartbeat stopped " + seconds_since(beat->second) + " s ago (its loop is stuck)";
+    } else if (!c.spec.resources.empty()) {
+      const bool all_heard = std::all_of(c.spec.resources.begin(), c.spec.resources.end(),
+                                         [&heard](const std::string& r) { return heard.count(r) > 0; });
+      if (all_heard) c.heard_at = now;
+      if (!all_heard && now - c.heard_at >= silence) why = "has not been heard on DDS for " + seconds_since(c.heard_at) + " s (hung?)";
     }
-    if (c.spec.resources.empty()) continue;
-    const bool all_heard = std::all_of(c.spec.resources.begin(), c.spec.resources.end(),
-                                       [&heard](const std::string& r) { return heard.count(r) > 0; });
-    if (all_heard) c.heard_at = now;
-    if (all_heard || now - c.heard_at < silence) continue;
-    const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(now - c.heard_at).count();
-    log_(c.spec.name, "unheard", c.spec.name + " runs but has not been heard on DDS for " + std::to_string(seconds) +
-                                     " s (hung?); ending it to restart it");
+    if (why.empty()) continue;
+    log_(c.spec.name, "unheard", c.spec.name + " runs but " + why + "; ending it to restart it");
     c.process->stop(std::chrono::seconds(2));  // tend() finds it ended
     ended.push_back(c.spec.name);
   }

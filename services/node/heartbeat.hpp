@@ -25,11 +25,12 @@ class Heartbeat {
  public:
   Heartbeat() {
     const char* path = std::getenv("NOTIFY_SOCKET");
-    if (!path || !*path || std::strlen(path) >= sizeof(address_.sun_path)) return;
+    const std::size_t size = path ? std::strlen(path) : 0;
+    if (size == 0 || size >= sizeof(address_.sun_path)) return;
     address_.sun_family = AF_UNIX;
-    std::memcpy(address_.sun_path, path, std::strlen(path));
+    std::memcpy(address_.sun_path, path, size);
     if (path[0] == '@') address_.sun_path[0] = '\0';  // an abstract socket (no file)
-    length_ = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + std::strlen(path));
+    length_ = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + size);
     fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
     if (const char* usec = std::getenv("WATCHDOG_USEC")) {  // systemd's: beat at half its interval
       const long long half = std::atoll(usec) / 2;
