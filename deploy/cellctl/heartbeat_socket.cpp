@@ -44,10 +44,22 @@ HeartbeatSocket::HeartbeatSocket() : name_("@agile-cell-heartbeat-" + std::to_st
 
 HeartbeatSocket::~HeartbeatSocket() { ::close(fd_); }
 
+void HeartbeatSocket::watch(pid_t pid) {
+  watched_.insert(pid);
+  last_beat_.erase(pid);  // a beat of an earlier process with its pid
+}
+
+void HeartbeatSocket::forget(pid_t pid) {
+  watched_.erase(pid);
+  last_beat_.erase(pid);
+}
+
 const std::map<pid_t, HeartbeatSocket::Clock::time_point>& HeartbeatSocket::beats() {
   char text[256];
   alignas(cmsghdr) char control[CMSG_SPACE(sizeof(ucred))];
-  for (;;) {
+  // A cell's processes send two a second each; past 4096 datagrams a call, the rest wait for
+  // the next call (a flood from a stranger does not hold up the supervisor).
+  for (int read = 0; read < 4096; ++read) {
     iovec io{text, sizeof text};
     msghdr message{};
     message.msg_iov = &io;
@@ -60,7 +72,9 @@ const std::map<pid_t, HeartbeatSocket::Clock::time_point>& HeartbeatSocket::beat
     if (!c || c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_CREDENTIALS) continue;
     ucred sender{};
     std::memcpy(&sender, CMSG_DATA(c), sizeof sender);
-    if (has_line({text, static_cast<std::size_t>(n)}, "WATCHDOG=1")) last_beat_[sender.pid] = Clock::now();
+    if (watched_.count(sender.pid) && has_line({text, static_cast<std::size_t>(n)}, "WATCHDOG=1")) {
+      last_beat_[sender.pid] = Clock::now();
+    }
   }
   return last_beat_;
 }

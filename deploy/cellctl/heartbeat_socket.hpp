@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <map>
+#include <set>
 #include <string>
 
 namespace cellctl {
@@ -23,13 +24,17 @@ class HeartbeatSocket {
 
   // The NOTIFY_SOCKET value for a child.
   const std::string& name() const { return name_; }
-  // Reads what came; when each pid that beat did so last.
+  // Beats are kept for the pids watched only (any local process may send to the socket).
+  void watch(pid_t pid);
+  void forget(pid_t pid);
+  // Reads what came (at most a bounded number of datagrams a call: a flood does not hold the
+  // caller); when each watched pid that beat did so last.
   const std::map<pid_t, Clock::time_point>& beats();
-  void forget(pid_t pid) { last_beat_.erase(pid); }
 
  private:
   int fd_ = -1;
   std::string name_;
+  std::set<pid_t> watched_;
   std::map<pid_t, Clock::time_point> last_beat_;
 };
 

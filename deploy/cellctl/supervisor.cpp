@@ -11,6 +11,7 @@ Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log
   for (auto& spec : specs) {
     Child child{std::move(spec), nullptr, {}, {}, 0, std::chrono::steady_clock::now()};
     child.process = std::make_unique<Process>(child.spec.name, child.spec.argv);
+    heartbeats_.watch(child.process->pid());
     children_.push_back(std::move(child));
   }
 }
@@ -42,7 +43,7 @@ std::string Supervisor::tend() {
     } else if (now >= c.restart_at) {
       try {
         c.process = std::make_unique<Process>(c.spec.name, c.spec.argv);
-        heartbeats_.forget(c.process->pid());  // a beat of an earlier process with its pid
+        heartbeats_.watch(c.process->pid());
         c.heard_at = std::chrono::steady_clock::now();
         ++c.restarts;
         log_(c.spec.name, "restarted", c.spec.name + " restarted (pid " + std::to_string(c.process->pid()) + ", restart " +
@@ -101,7 +102,9 @@ void Supervisor::restart_dependents(const Child& hub) {
                                             "; restarting them with it");
   stop_all(running);
   for (Child& c : children_) {
-    if (&c != &hub) c.process.reset();
+    if (&c == &hub || !c.process) continue;
+    heartbeats_.forget(c.process->pid());
+    c.process.reset();
   }
 }
 
