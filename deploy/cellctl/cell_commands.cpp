@@ -499,7 +499,7 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
       throw;
     }
     const auto log = [](const std::string& what) { std::cerr << "cellctl up: " << what << std::endl; };
-    OrderDesk desk(cell, store, observer.participant(), log);
+    OrderDesk desk(cell, store, observer.participant(), supervisor.heartbeats(), log);
     RemoteDesk remote(cell, store, observer, log);
     std::cout << "cell up on domain " << cell.domain << " (" << cell.resource_ids().size() << " resources, state in "
               << cell.state_folder().string() << "); `cellctl down --domain " << cell.domain << "` stops it"

@@ -232,7 +232,7 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   known_keys(file, root,
              {"domain", "real_time_factor", "liveliness_lease", "localhost_only", "station", "stations", "mobile_robot",
               "mobile_robots", "buffers", "bounds", "restart", "state_dir", "gripper", "security", "clients", "desk", "network",
-              "setup_cost", "currency", "standby_twins", "max_twins", "twin_identities", "fixtures", "discovery",
+              "setup_cost", "currency", "standby_twins", "max_twins", "twin_watchdog", "twin_identities", "fixtures", "discovery",
               "dashboard", "operators"});
   read(file, root, "domain", c.domain);
   read(file, root, "real_time_factor", c.real_time_factor);
@@ -274,6 +274,10 @@ CellConfig read_cell_config(const std::filesystem::path& file) {
   if (c.standby_twins < 0 || c.standby_twins > 16) throw ConfigError(where(file, root["standby_twins"]) + ": standby_twins must be 0..16");
   read(file, root, "max_twins", c.max_twins);
   if (c.max_twins < 1 || c.max_twins > 256) throw ConfigError(where(file, root["max_twins"]) + ": max_twins must be 1..256");
+  read(file, root, "twin_watchdog", c.twin_watchdog);
+  if (!(c.twin_watchdog >= 5 && c.twin_watchdog <= 3600)) {
+    throw ConfigError(where(file, root["twin_watchdog"]) + ": twin_watchdog must be 5..3600 s");
+  }
   read(file, root, "twin_identities", c.twin_identities);
   if (c.twin_identities < 1 || c.twin_identities > 256) {
     throw ConfigError(where(file, root["twin_identities"]) + ": twin_identities must be 1..256");

@@ -119,6 +119,11 @@ struct CellConfig {
   // `max_twins:` the twins cellctl up's desk runs at once for orders (standby ones apart); the
   // other orders wait in the cell's queue, in the order they came (docs/order-desk.md).
   int max_twins = 16;
+  // `twin_watchdog:` s a twin's heartbeat (services/node/heartbeat.hpp) may stay silent before
+  // cellctl up's desk ends it as hung and starts another for its order (it counts as died).
+  // A twin beats from its event loop and between the planner's steps; longer than its waits
+  // for the cell (30 s) and its exit watchdog (15 s).
+  double twin_watchdog = 60;
   // `twin_identities:` with security, the twins that may run at once, standby ones included:
   // each has a certificate of its own, twin-1 .. twin-N (deploy/cellctl/twin_identities.hpp).
   int twin_identities = 10;

@@ -1,14 +1,16 @@
 #include "deploy/cellctl/order_desk.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace cellctl {
 
 OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, dds::ParticipantPtr participant,
-                     std::function<void(const std::string&)> log, int max_deaths)
+                     HeartbeatSocket& heartbeats, std::function<void(const std::string&)> log, int max_deaths)
     : cell_(cell),
       store_(store),
+      heartbeats_(heartbeats),
       log_(std::move(log)),
       max_deaths_(max_deaths),
       identities_(cell.twin_identities_in_use(), std::move(participant)),
@@ -16,8 +18,25 @@ OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, dds::Parti
 
 OrderDesk::~OrderDesk() { interrupt_all(); }
 
+void OrderDesk::end_unheard_twins() {
+  const auto now = std::chrono::steady_clock::now();
+  const auto silence = std::chrono::duration<double>(cell_.twin_watchdog);
+  const auto& beats = heartbeats_.beats();
+  for (auto& [id, twin] : twins_) {
+    const auto beat = beats.find(twin.process->pid());
+    if (beat == beats.end() || now - beat->second <= silence || twin.process->poll() >= 0) continue;
+    const long silent = std::lround(std::chrono::duration<double>(now - beat->second).count());
+    const std::string why = "its heartbeat stopped " + std::to_string(silent) + " s ago (its loop is stuck; twin_watchdog " +
+                            std::to_string(std::lround(cell_.twin_watchdog)) + " s)";
+    log_("the twin of order " + id + " runs but " + why + "; ending it");
+    store_.journal("twin-" + id, "unheard", id, why);
+    twin.process->stop(std::chrono::seconds(2));  // found ended below, and started again as one that died
+  }
+}
+
 void OrderDesk::tend() {
   standby_.tend();
+  end_unheard_twins();
   const auto now = std::chrono::steady_clock::now();
   std::vector<std::pair<std::string, int>> ended;  // order, its twin's exit code
   for (auto it = twins_.begin(); it != twins_.end();) {
@@ -27,6 +46,7 @@ void OrderDesk::tend() {
       continue;
     }
     ended.emplace_back(it->first, code);
+    heartbeats_.forget(it->second.process->pid());
     identities_.give_back(it->second.identity);
     it = twins_.erase(it);
   }
@@ -110,6 +130,7 @@ void OrderDesk::tend() {
       const std::string started = "attempt " + std::to_string(attempt) + ", pid " + std::to_string(twin.process->pid()) +
                                   (was_standing_by ? ", standing by" : "") +
                                   (twin.identity.empty() ? "" : ", identity " + twin.identity);
+      heartbeats_.watch(twin.process->pid());
       twins_[id] = std::move(twin);  // before anything else can throw: its identity comes back when it ends
       if (attempt == 1) ++under_way;
       store_.journal("cellctl", "twin started", id, started);
@@ -142,7 +163,10 @@ void OrderDesk::interrupt_all() {
   std::vector<Process*> all;
   for (auto& [id, twin] : twins_) all.push_back(twin.process.get());
   stop_all(all);
-  for (auto& [id, twin] : twins_) identities_.give_back(twin.identity);
+  for (auto& [id, twin] : twins_) {
+    heartbeats_.forget(twin.process->pid());
+    identities_.give_back(twin.identity);
+  }
   twins_.clear();
 }
 

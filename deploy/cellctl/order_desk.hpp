@@ -15,6 +15,10 @@
 // (state QUEUED, journal "queued"), in the order they came, and start as those ahead end. An
 // order under way keeps its place while its twin is started again: no queued order takes
 // the twin of one that holds a station.
+//
+// A twin whose heartbeat (services/node/heartbeat.hpp, on the supervisor's socket) stops for
+// the cell's `twin_watchdog` is hung: the desk ends it (journal "twin unheard") and, as for
+// one that died, starts another for its order.
 
 #include <chrono>
 #include <functional>
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "deploy/cellctl/cell_config.hpp"
+#include "deploy/cellctl/heartbeat_socket.hpp"
 #include "deploy/cellctl/processes.hpp"
 #include "deploy/cellctl/twin_pool.hpp"
 #include "services/state/cell_store.hpp"
@@ -32,8 +37,9 @@ namespace cellctl {
 
 class OrderDesk {
  public:
-  // `participant`: cellctl up's, which binds twins to orders under security.
-  OrderDesk(const CellConfig& cell, state::CellStore& store, dds::ParticipantPtr participant,
+  // `participant`: cellctl up's, which binds twins to orders under security; `heartbeats`:
+  // the socket the twins beat on (the supervisor's: NOTIFY_SOCKET names it to them).
+  OrderDesk(const CellConfig& cell, state::CellStore& store, dds::ParticipantPtr participant, HeartbeatSocket& heartbeats,
             std::function<void(const std::string&)> log, int max_deaths = 5);
   static constexpr int kMaxAttemptsPerDeath = 4;
   ~OrderDesk();
@@ -51,8 +57,11 @@ class OrderDesk {
   static std::string place_text(const std::vector<std::string>& queue, const std::string& order);
 
  private:
+  void end_unheard_twins();
+
   const CellConfig& cell_;
   state::CellStore& store_;
+  HeartbeatSocket& heartbeats_;
   std::function<void(const std::string&)> log_;
   int max_deaths_;
   std::map<std::string, int> deaths_;  // order -> its twins that died (since this desk started)

@@ -39,6 +39,8 @@ class Supervisor {
   // was, in a deadlock inside Fast DDS). tend() restarts it as one that died. Returns the
   // names of those it ended.
   std::vector<std::string> end_unheard(const std::set<std::string>& heard, std::chrono::steady_clock::duration silence);
+  // The socket its children beat on, and what else it starts (the desk's twins).
+  HeartbeatSocket& heartbeats() { return heartbeats_; }
   // Whether a process of this supervisor publishes the resource.
   bool runs(const std::string& resource) const;
   void stop();

@@ -4,6 +4,7 @@
 
 #include <signal.h>
 
+#include <fstream>
 #include <set>
 
 #include <catch2/catch.hpp>
@@ -191,6 +192,40 @@ TEST_CASE("a twin killed during physical assembly is started again and finishes 
   check_taken_up(state_dir, "tower", placed, 11);
   const json status = status_json(domain, dir);
   for (const auto& r : status["resources"]) CHECK(r["reserved_by"] == "");
+  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
+  CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("a twin frozen during physical assembly falls silent: the desk ends it, and the next one finishes the order",
+          "[process][cell][state]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = test::scratch("twin-frozen");
+  const fs::path state_dir = dir / "state", log = dir / "up.log", cell = dir / "cell.yaml";
+  {
+    std::ofstream out(cell);
+    out << test::read_text(fs::path(DEPLOY_CELLS) / "default.yaml") << "\ntwin_watchdog: 5\n";
+  }
+  const std::string domain = "176";
+  test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
+                         "--state-dir", state_dir.string()},
+                        log.string());
+  REQUIRE(test::appears(log, "cell up on domain"));
+  test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
+                             domain, "--order", "tower", "--out", (dir / "tower").string()},
+                            (dir / "submit.log").string());
+  const auto placed = wait_for_placed(state_dir, "tower", 3);
+  REQUIRE(placed.size() >= 3);
+  const pid_t twin = test::twin_of(state::CellStore(state_dir), "tower");
+  REQUIRE(twin > 0);
+  ::kill(twin, SIGSTOP);  // alive on DDS for its lease, its loop stopped: only its heartbeat tells
+  const int code = submit.wait_for_exit(150s);
+  INFO(test::last_lines(dir / "submit.log", 6) << test::last_lines(log, 20));
+  CHECK(code == 0);
+  const std::string said = test::read_text(log);
+  CHECK(said.find("the twin of order tower runs but its heartbeat stopped") != std::string::npos);
+  CHECK(said.find("order tower: twin started again (attempt 2)") != std::string::npos);
+  CHECK(::kill(twin, 0) != 0);  // ended, not left stopped
+  check_taken_up(state_dir, "tower", placed, 11);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
 }

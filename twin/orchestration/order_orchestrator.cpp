@@ -627,7 +627,7 @@ void OrderOrchestrator::back_to_sequence_planning() {
   }
   barred_.erase(barred_.upper_bound(step_), barred_.end());
   barred_[step_].insert(part);
-  PlannerOptions options;
+  PlannerOptions options = settings_.replanning;
   options.gripper = settings_.gripper;
   options.given.assign(plan_.steps.begin(), plan_.steps.begin() + step_);  // validated already
   options.not_next = barred_[step_];

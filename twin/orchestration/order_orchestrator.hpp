@@ -103,6 +103,9 @@ struct OrderSettings {
   double arm_speed = 0.25;          // m/s: virtual assembly's moves, until an arm's capability says
   double arm_angular_speed = 1.0;   // rad/s
   fb::GripperGeometry gripper;     // the cell's (deployment key `gripper:`), as the plan used it
+  // How it plans again when virtual assembly finds no path (back to sequence planning), as the
+  // first plan was made: the cell's fixtures, and `stop`, asked between the search's steps.
+  PlannerOptions replanning;
   // Taking up an order whose earlier twin ended during physical assembly (assembly_script.hpp).
   Resume resume;
   // A resource it hired restarted under its work (services/node/restart_reason.hpp): end

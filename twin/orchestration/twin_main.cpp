@@ -45,6 +45,7 @@
 #include "twin/report/html_report.hpp"
 #include "twin/report/plan_json.hpp"
 #include "twin/planning/work_memory.hpp"
+#include "services/node/heartbeat.hpp"
 #include "services/node/run.hpp"
 #include "services/state/cell_store.hpp"
 
@@ -145,7 +146,7 @@ class TwinProcess {
     twin::PlannerOptions planning;
     planning.gripper = options_.gripper;
     planning.fixtures = options_.fixtures;
-    planning.stop = [this] { return !running || cancel_asked(); };
+    planning.stop = [this] { return planning_stopped(); };
     twin::OrientedPlan oriented = plan_order(*loaded, *path, planning);
     if (!running) return end_with(1, "stopped while it was planned");
     if (!cancelled_by_.empty()) return end_with(1, "cancelled by " + cancelled_by_);
@@ -163,6 +164,13 @@ class TwinProcess {
   }
 
  private:
+  // Asked between the planner's steps: the search runs on this thread for as long as it
+  // needs, so the heartbeat beats here too.
+  bool planning_stopped() {
+    heartbeat_.beat();
+    return !running || cancel_asked();
+  }
+
   // Whether the operator asked to cancel the order (cellctl cancel, the dashboard): the cell's
   // state is read at most once a second, and a read the busy database refused is tried at the
   // next. Sets cancelled_by_.
@@ -276,6 +284,7 @@ class TwinProcess {
     };
     while (!store_->commands_of(options_.order).empty() || in_transit()) {
       if (std::chrono::steady_clock::now() > deadline || !running) return false;
+      heartbeat_.beat();
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     for (const auto& p : store_->parts(options_.order)) {
@@ -352,6 +361,8 @@ class TwinProcess {
     settings.wait_timeout = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
     settings.gripper = options_.gripper;
     settings.quote_only = options_.quote;
+    settings.replanning.fixtures = options_.fixtures;
+    settings.replanning.stop = [this] { return planning_stopped(); };
     settings.real_time_factor = [this] { return clock_.real_time_factor(); };
     fb::NegotiationSettings negotiation;
     negotiation.wait = settings.wait_timeout;
@@ -459,6 +470,7 @@ class TwinProcess {
     auto last_tick = std::chrono::steady_clock::now();
     bool cancelled = false;
     while (!finished && running) {
+      heartbeat_.beat();
       r.wait_and_run_one(std::chrono::milliseconds(50));
       const auto now = std::chrono::steady_clock::now();
       if (now - last_tick > std::chrono::milliseconds(100)) {
@@ -513,6 +525,8 @@ class TwinProcess {
   std::chrono::steady_clock::time_point cancel_looked_at_{};
   twin::Resume resume_;
   std::string stored_state_;
+  // To cellctl up's desk, which ends a twin that falls silent (cell_config.hpp, twin_watchdog).
+  services::Heartbeat heartbeat_;
 };
 
 }  // namespace
