@@ -261,3 +261,62 @@ TEST_CASE("grasps: a bar lying turned 45 degrees is held across its own width, n
   CHECK_THAT(grasp.label, Catch::Contains("turned 45 deg"));
   CHECK(grasp.opening == Approx(0.02).margin(1e-9));
 }
+
+TEST_CASE("grasps: beside the centre, the fingers close on the part where they stand", "[planning][grasp]") {
+  // A disc 130 mm across, 40 mm tall (a table's base): a quarter of its length from its rim,
+  // 32.5 mm off its centre, the fingers (8 mm wide) open to its widest chord between them, at
+  // 28.5 mm off the centre: 2 sqrt(65^2 - 28.5^2) = 116.8 mm.
+  sim::TriangleMesh disc = test::tube_mesh(256, 0.065, 0, 0.04);
+  for (const auto& v : disc.vertices) disc.bounds.extend(v);
+  const fb::GripperGeometry gripper;
+  const auto centred = twin::grasps_for(disc.bounds, twin::Pose::Identity(), -Vec3::UnitY(), gripper);
+  REQUIRE(centred.front().label == "across x from above");
+  const auto beside = twin::off_centre_grasps(centred.front(), disc, gripper);
+  REQUIRE(beside.size() == 2);
+  for (const auto& g : beside) {
+    INFO(g.label);
+    CHECK_THAT(g.label, Catch::Contains("33 mm off-centre"));
+    CHECK(g.opening == Approx(0.1168).margin(0.0005));
+    CHECK(std::abs(std::abs(g.gripper.translation().z()) - 0.0325) < 1e-9);
+    CHECK(std::abs(g.gripper.translation().x()) < 1e-4);  // the chord is centred on the axis
+    CHECK(twin::fingers_touch(disc, g, gripper, 0.001));
+  }
+  // Where no surface is between the fingers, no grasp: a part shorter than four fingers'
+  // widths has none beside its centre.
+  sim::TriangleMesh pin = test::box_mesh(Vec3(0.01, 0.02, 0.01));
+  CHECK(twin::off_centre_grasps(twin::grasps_for(pin.bounds, twin::Pose::Identity(), -Vec3::UnitY(), gripper).front(),
+                                pin, gripper)
+            .empty());
+}
+
+TEST_CASE("grasps: a bar whose middle has a post beside it is held off its centre", "[planning][grasp]") {
+  // A frame of one piece: a plate, end walls 2 mm beyond the bar's ends, and a post 2 mm
+  // beside the bar's middle; the bar, 240 x 20 x 20 mm, is lowered onto the plate between
+  // them. From above across z a finger at the middle goes into the post; from the ends the
+  // carriage meets the walls; from the sides a finger goes under the bar into the plate. A
+  // quarter of the way from either end the fingers are clear.
+  test::ProductMaker make("bar-by-a-post");
+  sim::TriangleMesh frame;
+  test::add_box(frame, {-0.130, 0, -0.050}, {0.130, 0.010, 0.050});  // the plate
+  frame.pieces.emplace_back();
+  test::add_box(frame, {-0.130, 0.010, -0.050}, {-0.122, 0.100, 0.050});  // end walls
+  frame.pieces.emplace_back();
+  test::add_box(frame, {0.122, 0.010, -0.050}, {0.130, 0.100, 0.050});
+  frame.pieces.emplace_back();
+  test::add_box(frame, {-0.010, 0.010, 0.012}, {0.010, 0.100, 0.040});  // the post
+  make.part("frame", std::move(frame));
+  sim::TriangleMesh bar;
+  test::add_box(bar, {-0.120, 0.010, -0.010}, {0.120, 0.030, 0.010});
+  make.part("bar", std::move(bar));
+  make.link("frame", "bar");
+  const twin::LoadedProduct product = make.take();
+  const twin::Plan plan = plan_of(product);
+  std::string findings;
+  for (const auto& f : plan.findings) findings += f.kind + ": " + f.message + "\n";
+  INFO(findings);
+  REQUIRE(plan.complete);
+  REQUIRE(plan.steps.size() == 2);
+  const twin::Grasp& grasp = plan.steps[1].trajectory.grasp;
+  CHECK_THAT(grasp.label, Catch::StartsWith("across z from above") && Catch::Contains("60 mm off-centre"));
+  CHECK(grasp.opening == Approx(0.02).margin(1e-9));
+}

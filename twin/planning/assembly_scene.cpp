@@ -242,7 +242,6 @@ std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajecto
   for (const Grasp& g : all) {
     if (g.label != trajectory.grasp.label && holds(part, g)) holding.push_back(g);
   }
-  if (holding.empty()) return Collision{"", "finger", 0, "gripping"};
   const auto run = [&](const Grasp& grasp) {
     trajectory.hold_by(grasp);
     if (known) {
@@ -252,13 +251,38 @@ std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajecto
     if (known && c) known->remember(part, trajectory.label, grasp.label, *c);
     return c;
   };
-  std::optional<Collision> first = run(holding.front());
-  if (!first || first->member == "part") return first;  // no other grasp helps a part that hits
-  for (std::size_t i = 1; i < holding.size(); ++i) {
-    if (!run(holding[i])) return std::nullopt;
+  std::optional<Collision> first;
+  if (!holding.empty()) {
+    first = run(holding.front());
+    if (!first || first->member == "part") return first;  // no other grasp helps a part that hits
+    for (std::size_t i = 1; i < holding.size(); ++i) {
+      if (!run(holding[i])) return std::nullopt;
+    }
+  }
+  // Then beside the part's centre (off_centre_grasps), where the centred fingers met
+  // something (a post by the part's middle; the station, under a side grasp moved up) or
+  // closed on air: each side and closing axis once, the fingers half-way in.
+  const Grasp own = trajectory.grasp;
+  for (const Grasp& centred : all) {
+    if (centred.label.find(", shallow") != std::string::npos || centred.label.find(", deep") != std::string::npos) continue;
+    for (const Grasp& g : off_centre(part, centred)) {
+      if (holds(part, g) && !run(g)) return std::nullopt;
+    }
+  }
+  if (holding.empty()) {
+    trajectory.hold_by(own);
+    return Collision{"", "finger", 0, "gripping"};
   }
   trajectory.hold_by(holding.front());
   return first;
+}
+
+const std::vector<Grasp>& AssemblyScene::off_centre(PartIndex part, const Grasp& centred) const {
+  auto [it, made] = off_centre_.try_emplace({part, centred.label});
+  if (made) {
+    if (const auto& mesh = held_by(part)) it->second = off_centre_grasps(centred, *mesh, gripper_);
+  }
+  return it->second;
 }
 
 std::optional<Margin> AssemblyScene::margin(PartIndex part, const Trajectory& trajectory, double reach) const {

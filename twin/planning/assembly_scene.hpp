@@ -102,8 +102,8 @@ class AssemblyScene {
   // the part is one of phase "gripping", before any move.
   std::optional<Collision> simulate(PartIndex part, const Trajectory& trajectory) const;
   // Runs the trajectory with its own grasp, then with the part's other grasps for its
-  // direction, and keeps the first that is free of collisions through insertion and
-  // retreat. Where none is, the trajectory keeps its own grasp and the answer is its
+  // direction, then beside the part's centre those whose gripper hit a part (grasp.hpp), and
+  // keeps the first that is free of collisions through insertion and retreat. Where none is, the trajectory keeps its own grasp and the answer is its
   // collision (or, with no grasp at all, one of phase "grasp"). With `known`, a grasp whose
   // collision recurs is not run again, and what is found is remembered there.
   std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory, KnownCollisions* known = nullptr) const;
@@ -143,6 +143,10 @@ class AssemblyScene {
   };
   const Footprint& footprint(PartIndex part) const;
   mutable std::map<PartIndex, Footprint> footprints_;
+  // off_centre_grasps() of each grasp, by part and the centred grasp's label: found from the
+  // part's triangles, when every centred grasp failed.
+  const std::vector<Grasp>& off_centre(PartIndex part, const Grasp& centred) const;
+  mutable std::map<std::pair<PartIndex, std::string>, std::vector<Grasp>> off_centre_;
 
   std::vector<Eigen::AlignedBox3d> bounds_;
   std::vector<Eigen::AlignedBox3d> grasp_bounds_;  // of what the gripper holds each part by

@@ -1,6 +1,8 @@
 #include "twin/planning/finger_contact.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <vector>
 
 #include <CGAL/Intersections_3/Bbox_3_Triangle_3.h>
 #include <CGAL/Simple_cartesian.h>
@@ -28,7 +30,41 @@ bool meets(const sim::TriangleMesh& part, const std::vector<Eigen::Vector3d>& v,
   });
 }
 
+// The polygon's part on the side of the plane where `inside` is not negative (Sutherland and
+// Hodgman's clipping, one plane).
+template <typename Inside>
+std::vector<Eigen::Vector3d> clipped(const std::vector<Eigen::Vector3d>& polygon, Inside inside) {
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector3d& a = polygon[i];
+    const Eigen::Vector3d& b = polygon[(i + 1) % polygon.size()];
+    const double da = inside(a), db = inside(b);
+    if (da >= 0) out.push_back(a);
+    if ((da < 0) != (db < 0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
 }  // namespace
+
+std::optional<std::pair<double, double>> span_between_fingers(const sim::TriangleMesh& part, const Grasp& grasp,
+                                                              const fb::GripperGeometry& gripper) {
+  const auto v = in_gripper_frame(part, grasp);
+  const double top = -gripper.palm_thickness / 2, bottom = top - gripper.finger_length, width = gripper.finger_width / 2;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& t : part.triangles) {
+    std::vector<Eigen::Vector3d> p{v[t[0]], v[t[1]], v[t[2]]};
+    const auto [min, max] = std::minmax({p[0].z(), p[1].z(), p[2].z()});
+    if (max < -width || min > width) continue;
+    p = clipped(p, [&](const Eigen::Vector3d& q) { return top - q.y(); });
+    p = clipped(p, [&](const Eigen::Vector3d& q) { return q.y() - bottom; });
+    p = clipped(p, [&](const Eigen::Vector3d& q) { return width - q.z(); });
+    p = clipped(p, [&](const Eigen::Vector3d& q) { return q.z() + width; });
+    for (const auto& q : p) lo = std::min(lo, q.x()), hi = std::max(hi, q.x());
+  }
+  if (lo > hi) return std::nullopt;
+  return std::make_pair(lo, hi);
+}
 
 bool fingers_touch(const sim::TriangleMesh& part, const Grasp& grasp, const fb::GripperGeometry& gripper, double within) {
   const auto v = in_gripper_frame(part, grasp);

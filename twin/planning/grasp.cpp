@@ -7,6 +7,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_2.h>
 
+#include "twin/planning/finger_contact.hpp"
+
 namespace twin {
 namespace {
 
@@ -70,6 +72,29 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
       if (quarter < half) add(quarter, ", shallow");
       if (deep > half + kDeepGraspClearance) add(deep, ", deep");
     }
+  }
+  return out;
+}
+
+std::vector<Grasp> off_centre_grasps(const Grasp& centred, const sim::TriangleMesh& part,
+                                     const fb::GripperGeometry& gripper) {
+  const Pose to_gripper = centred.gripper.inverse();
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;  // along the fingers' width (z)
+  for (const Vec3& v : part.vertices) {
+    const double z = (to_gripper * v).z();
+    lo = std::min(lo, z), hi = std::max(hi, z);
+  }
+  std::vector<Grasp> out;
+  if (!(hi - lo >= 4 * gripper.finger_width)) return out;
+  for (const double along : {lo + (hi - lo) / 4, hi - (hi - lo) / 4}) {
+    Grasp moved = centred;
+    moved.gripper = centred.gripper * Eigen::Translation3d(0, 0, along);
+    const auto span = span_between_fingers(part, moved, gripper);
+    if (!span || span->second - span->first > gripper.max_opening) continue;
+    moved.gripper = moved.gripper * Eigen::Translation3d((span->first + span->second) / 2, 0, 0);
+    moved.opening = span->second - span->first;
+    moved.label += ", " + std::to_string(std::lround(std::abs(along) * 1000)) + " mm off-centre" + (along > 0 ? " (+)" : " (-)");
+    out.push_back(std::move(moved));
   }
   return out;
 }

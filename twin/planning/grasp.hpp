@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "services/node/gripper.hpp"
+#include "sim/mesh/triangle_mesh.hpp"
 #include "twin/model/frame.hpp"
 
 namespace twin {
@@ -27,6 +28,15 @@ struct Grasp {
 // short of the part's far side (the low walls of a tray).
 std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_pose, const Vec3& direction,
                               const fb::GripperGeometry& gripper);
+
+// The grasp moved along the fingers' width (across the closing axis and the approach) to a
+// quarter of the part's length from either end: for a part whose middle is taken where the
+// centred fingers go (a leg stands on a base's centre). The fingers close on the part where
+// they then stand: the opening and its centre come from `part`'s surface between them
+// (finger_contact.hpp); a position with no surface there, or one wider than the gripper
+// opens, is left out, as is every one on a part shorter than four fingers' widths.
+std::vector<Grasp> off_centre_grasps(const Grasp& centred, const sim::TriangleMesh& part,
+                                     const fb::GripperGeometry& gripper);
 
 // The turn about the vertical (y) that lines a part's footprint up with the axes: the angle in
 // [0, pi/2) of the smallest rectangle around the points' (x, z), which lies along an edge of
