@@ -52,7 +52,9 @@ killed=0 most=0 peak_kb=0
 while [ "$(ended)" -lt "$orders" ]; do
   twins=$(pgrep -c -x twin || true)
   [ "$twins" -gt "$most" ] && most=$twins
-  kb=$(for p in $(pgrep -f "domain $domain"); do awk '/VmRSS/{print $2}' "/proc/$p/status" 2>/dev/null; done | awk '{s+=$1} END {print s+0}')
+  # A process may end between pgrep and awk: that is no error (set -e, pipefail).
+  kb=$(for p in $(pgrep -f "domain $domain" || true); do awk '/VmRSS/{print $2}' "/proc/$p/status" 2>/dev/null || true; done |
+       awk '{s+=$1} END {print s+0}')
   [ "$kb" -gt "$peak_kb" ] && peak_kb=$kb
   if [ "$killed" = 0 ] && [ "$(ended)" -ge $((orders / 3)) ]; then
     kill -9 "$up_pid"; wait "$up_pid" 2>/dev/null || true
