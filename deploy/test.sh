@@ -2,7 +2,7 @@
 # Installs what is missing, then builds and runs the whole test suite twice: a Release
 # build (GCC), and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer; then
 # the block, DDS and process tests (labels blocks, dds, processes) once more under
-# ThreadSanitizer; then each libFuzzer target for 30 s (deploy/fuzz.sh; longer runs,
+# ThreadSanitizer; then each libFuzzer target for 15 s (deploy/fuzz.sh; longer runs,
 # optimised, by hand). The sanitizer trees are built with clang: it compiles them faster
 # than GCC, and the libFuzzer targets are built in the ASan tree, one build less. All three
 # are unity builds (CMake joins up to 8 sources of a library or program into one: the large
@@ -58,4 +58,4 @@ TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/ts
   ctest --test-dir build/tsan --output-on-failure -j "$jobs" -L "blocks|dds|processes" \
   -E "^(quotes come true|quotes|many orders: ten orders on the one-station cell queue|the operator takes a station out of service)"
 
-bash deploy/fuzz.sh 30 build/sanitize
+bash deploy/fuzz.sh 15 build/sanitize

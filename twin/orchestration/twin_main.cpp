@@ -462,7 +462,13 @@ class TwinProcess {
 
     for (auto& start : starters_) start();
     const auto wait = std::chrono::milliseconds(static_cast<long>(options_.wait_s * 1000));
-    if (!sim.writer().wait_for_readers(1, wait)) {
+    bool sim_found = false;  // asked a second at a time, beating: the desk's watchdog may be shorter than the wait
+    for (std::chrono::milliseconds waited{0}; !sim_found && waited < wait && running; waited += std::chrono::seconds(1)) {
+      heartbeat_.beat();
+      sim_found = sim.writer().wait_for_readers(1, std::chrono::seconds(1));
+    }
+    if (!running) return end_with(1, "stopped while it waited for the cell");
+    if (!sim_found) {
       return end_with(1, "cell-sim did not appear within " + std::to_string(static_cast<int>(options_.wait_s)) +
                              " s: is the cell up on domain " + std::to_string(options_.dds.domain_id) + "?");
     }

@@ -102,9 +102,9 @@ class AssemblyScene {
   // the part is one of phase "gripping", before any move.
   std::optional<Collision> simulate(PartIndex part, const Trajectory& trajectory) const;
   // Runs the trajectory with its own grasp, then with the part's other grasps for its
-  // direction, then beside the part's centre those whose gripper hit a part (grasp.hpp), and
-  // keeps the first that is free of collisions through insertion and retreat. Where none is, the trajectory keeps its own grasp and the answer is its
-  // collision (or, with no grasp at all, one of phase "grasp"). With `known`, a grasp whose
+  // direction, then with each of them beside the part's centre (off_centre_grasps, grasp.hpp),
+  // and keeps the first that is free of collisions through insertion and retreat. Where none
+  // is, the trajectory keeps its own grasp and the answer is its collision (or, with no grasp at all, one of phase "grasp"). With `known`, a grasp whose
   // collision recurs is not run again, and what is found is remembered there.
   std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory, KnownCollisions* known = nullptr) const;
 
