@@ -5,6 +5,7 @@
 #include <signal.h>
 
 #include <fstream>
+#include <functional>
 #include <set>
 
 #include <catch2/catch.hpp>
@@ -165,17 +166,19 @@ void check_taken_up(const fs::path& state_dir, const std::string& order, const s
   for (const auto& [type, c] : store.inventory()) CHECK(c.initial == c.accounted());
 }
 
-}  // namespace
-
-TEST_CASE("a twin killed during physical assembly is started again and finishes the order, no step done twice",
-          "[process][cell][state]") {
+// A Lego tower submitted to `cellctl up` (with `up_args` more), its twin sent `signal` once
+// three parts are placed: the order must end assembled, taken up by the next twin, no step
+// done twice. `then` is asked before the cell goes down, with up's log and the first twin's pid.
+void twin_signalled_mid_order(const std::string& name, const std::string& domain, int signal,
+                              const std::vector<std::string>& up_args,
+                              const std::function<void(const fs::path& dir, const std::string& log, pid_t twin)>& then) {
   test::clean_stale_dds_segments();
-  const fs::path dir = test::scratch("twin-resume");
+  const fs::path dir = test::scratch(name);
   const fs::path state_dir = dir / "state", log = dir / "up.log";
-  const std::string domain = "197";
-  test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir",
-                         state_dir.string()},
-                        log.string());
+  std::vector<std::string> up_argv{CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir",
+                                   state_dir.string()};
+  up_argv.insert(up_argv.end(), up_args.begin(), up_args.end());
+  test::ChildProcess up(up_argv, log.string());
   REQUIRE(test::appears(log, "cell up on domain"));
   test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
                              domain, "--order", "tower", "--out", (dir / "tower").string()},
@@ -184,50 +187,39 @@ TEST_CASE("a twin killed during physical assembly is started again and finishes 
   REQUIRE(placed.size() >= 3);
   const pid_t twin = test::twin_of(state::CellStore(state_dir), "tower");
   REQUIRE(twin > 0);
-  ::kill(twin, SIGKILL);
-  const int code = submit.wait_for_exit(150s);
-  INFO(test::read_text(dir / "submit.log") << test::read_text(log));
-  CHECK(code == 0);
-  CHECK(test::read_text(log).find("order tower: twin started again (attempt 2)") != std::string::npos);
-  check_taken_up(state_dir, "tower", placed, 11);
-  const json status = status_json(domain, dir);
-  for (const auto& r : status["resources"]) CHECK(r["reserved_by"] == "");
-  CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
-  CHECK(up.wait_for_exit(20s) == 0);
-}
-
-TEST_CASE("a twin frozen during physical assembly falls silent: the desk ends it, and the next one finishes the order",
-          "[process][cell][state]") {
-  test::clean_stale_dds_segments();
-  const fs::path dir = test::scratch("twin-frozen");
-  const fs::path state_dir = dir / "state", log = dir / "up.log", cell = dir / "cell.yaml";
-  {
-    std::ofstream out(cell);
-    out << test::read_text(fs::path(DEPLOY_CELLS) / "default.yaml") << "\ntwin_watchdog: 5\n";
-  }
-  const std::string domain = "176";
-  test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
-                         "--state-dir", state_dir.string()},
-                        log.string());
-  REQUIRE(test::appears(log, "cell up on domain"));
-  test::ChildProcess submit({CELLCTL_EXE, "submit", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--domain",
-                             domain, "--order", "tower", "--out", (dir / "tower").string()},
-                            (dir / "submit.log").string());
-  const auto placed = wait_for_placed(state_dir, "tower", 3);
-  REQUIRE(placed.size() >= 3);
-  const pid_t twin = test::twin_of(state::CellStore(state_dir), "tower");
-  REQUIRE(twin > 0);
-  ::kill(twin, SIGSTOP);  // alive on DDS for its lease, its loop stopped: only its heartbeat tells
+  ::kill(twin, signal);
   const int code = submit.wait_for_exit(150s);
   INFO(test::last_lines(dir / "submit.log", 6) << test::last_lines(log, 20));
   CHECK(code == 0);
   const std::string said = test::read_text(log);
-  CHECK(said.find("the twin of order tower runs but its heartbeat stopped") != std::string::npos);
   CHECK(said.find("order tower: twin started again (attempt 2)") != std::string::npos);
-  CHECK(::kill(twin, 0) != 0);  // ended, not left stopped
   check_taken_up(state_dir, "tower", placed, 11);
+  then(dir, said, twin);
   CHECK(test::cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
+}
+
+}  // namespace
+
+TEST_CASE("a twin killed during physical assembly is started again and finishes the order, no step done twice",
+          "[process][cell][state]") {
+  const std::string domain = "197";
+  twin_signalled_mid_order("twin-resume", domain, SIGKILL, {}, [&](const fs::path& dir, const std::string&, pid_t) {
+    const json status = status_json(domain, dir);
+    for (const auto& r : status["resources"]) CHECK(r["reserved_by"] == "");
+  });
+}
+
+TEST_CASE("a twin frozen during physical assembly falls silent: the desk ends it, and the next one finishes the order",
+          "[process][cell][state]") {
+  const fs::path cell = test::scratch("twin-frozen-cell") / "cell.yaml";
+  std::ofstream(cell) << test::read_text(fs::path(DEPLOY_CELLS) / "default.yaml") << "\ntwin_watchdog: 5\n";
+  // SIGSTOP: alive on DDS for its lease, its loop stopped: only its heartbeat tells.
+  twin_signalled_mid_order("twin-frozen", "176", SIGSTOP, {"--cell", cell.string()},
+                           [](const fs::path&, const std::string& log, pid_t twin) {
+                             CHECK(log.find("the twin of order tower runs but its heartbeat stopped") != std::string::npos);
+                             CHECK(::kill(twin, 0) != 0);  // ended, not left stopped
+                           });
 }
 
 TEST_CASE("a twin killed once a subassembly stands built aside: the next one inserts it as it stands",
