@@ -79,4 +79,15 @@ const std::map<pid_t, HeartbeatSocket::Clock::time_point>& HeartbeatSocket::beat
   return last_beat_;
 }
 
+std::map<pid_t, std::string> HeartbeatSocket::stopped(Clock::duration silence) {
+  const auto now = Clock::now();
+  std::map<pid_t, std::string> out;
+  for (const auto& [pid, at] : beats()) {
+    if (now - at <= silence) continue;
+    const auto ago = std::chrono::duration_cast<std::chrono::seconds>(now - at).count();
+    out[pid] = "its heartbeat stopped " + std::to_string(ago) + " s ago (its loop is stuck)";
+  }
+  return out;
+}
+
 }  // namespace cellctl

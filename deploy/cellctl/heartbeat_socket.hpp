@@ -30,6 +30,9 @@ class HeartbeatSocket {
   // Reads what came (at most a bounded number of datagrams a call: a flood does not hold the
   // caller); when each watched pid that beat did so last.
   const std::map<pid_t, Clock::time_point>& beats();
+  // Reads what came; for each watched pid that beat and then fell silent for longer than
+  // `silence`, why it is taken for hung: "its heartbeat stopped 31 s ago (its loop is stuck)".
+  std::map<pid_t, std::string> stopped(Clock::duration silence);
 
  private:
   int fd_ = -1;

@@ -19,15 +19,12 @@ OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, dds::Parti
 OrderDesk::~OrderDesk() { interrupt_all(); }
 
 void OrderDesk::end_unheard_twins() {
-  const auto now = std::chrono::steady_clock::now();
-  const auto silence = std::chrono::duration<double>(cell_.twin_watchdog);
-  const auto& beats = heartbeats_.beats();
+  const auto stopped = heartbeats_.stopped(std::chrono::duration_cast<HeartbeatSocket::Clock::duration>(
+      std::chrono::duration<double>(cell_.twin_watchdog)));
   for (auto& [id, twin] : twins_) {
-    const auto beat = beats.find(twin.process->pid());
-    if (beat == beats.end() || now - beat->second <= silence || twin.process->poll() >= 0) continue;
-    const long silent = std::lround(std::chrono::duration<double>(now - beat->second).count());
-    const std::string why = "its heartbeat stopped " + std::to_string(silent) + " s ago (its loop is stuck; twin_watchdog " +
-                            std::to_string(std::lround(cell_.twin_watchdog)) + " s)";
+    const auto beat = stopped.find(twin.process->pid());
+    if (beat == stopped.end() || twin.process->poll() >= 0) continue;
+    const std::string why = beat->second + ", past twin_watchdog " + std::to_string(std::lround(cell_.twin_watchdog)) + " s";
     log_("the twin of order " + id + " runs but " + why + "; ending it");
     store_.journal("twin-" + id, "unheard", id, why);
     twin.process->stop(std::chrono::seconds(2));  // found ended below, and started again as one that died

@@ -63,12 +63,12 @@ std::vector<std::string> Supervisor::end_unheard(const std::set<std::string>& he
     return std::to_string(std::chrono::duration_cast<std::chrono::seconds>(now - t).count());
   };
   std::vector<std::string> ended;
-  const auto& beats = heartbeats_.beats();
+  const auto stopped = heartbeats_.stopped(silence);
   for (Child& c : children_) {
     if (!c.process) continue;
     std::string why;  // "" while it is not hung
-    if (const auto beat = beats.find(c.process->pid()); beat != beats.end() && now - beat->second > silence) {
-      why = "its heartbeat stopped " + seconds_since(beat->second) + " s ago (its loop is stuck)";
+    if (const auto beat = stopped.find(c.process->pid()); beat != stopped.end()) {
+      why = beat->second;
     } else if (!c.spec.resources.empty()) {
       const bool all_heard = std::all_of(c.spec.resources.begin(), c.spec.resources.end(),
                                          [&heard](const std::string& r) { return heard.count(r) > 0; });
