@@ -17,8 +17,7 @@ std::string margin_text(const twin::PlanStep& step, double reach) {
 }  // namespace
 
 void print_plan(const twin::Product& product, const twin::Plan& plan, std::ostream& out) {
-  std::size_t placed = 0;
-  for (const auto& step : plan.steps) placed += step.carried.empty() ? 1 : 0;
+  const std::size_t placed = plan.parts_placed();
   out << "Plan for '" << product.name() << "' (sequence: " << plan.sequence_planner << ", path: " << plan.path_planner
       << "): " << (plan.complete ? "complete" : "INCOMPLETE") << ", " << placed << " of " << product.parts().size()
       << " parts";

@@ -100,6 +100,33 @@ TEST_CASE("gravity: a block stands on the station and on a block, and topples be
   CHECK(twin::describe(product.product, *falls, {}).find("ledge: nothing holds it up") == 0);
 }
 
+TEST_CASE("gravity: a state asked before is remembered by where its parts stand, translation too", "[stability]") {
+  // The memory once keyed a pose by the first twelve numbers of its 4x4 matrix, which leave the
+  // translation out: a part lifted or moved aside was answered as where it was first asked,
+  // and a subassembly built aside then set in place lost its support (the station's contacts
+  // of the aside pose).
+  const test::ScratchDir dir("stability-moved");
+  Boxes b;
+  b.boxes = {{"base", {0, 0, 0}, {100, 10, 100}}, {"block", {70, 10, 40}, {90, 30, 60}}};
+  b.links = {{"base", "block", ""}};
+  const auto product = test::load(b.write(dir.path()));
+  const twin::StabilityAnalysis analysis(product);
+  const twin::PartIndex base = 0, block = 1;
+  const twin::Pose finished = twin::Pose::Identity();
+  CHECK_FALSE(analysis.check({{base, finished}}));
+  twin::Pose lifted = finished;
+  lifted.translation().y() = 0.04;
+  const auto in_the_air = analysis.check({{base, lifted}});
+  REQUIRE(in_the_air);
+  CHECK(in_the_air->tilt == 0);
+  // Asked first 150 mm aside, then where it stands finished with the block on its edge: the
+  // station bears the plate where it now is.
+  twin::Pose aside = finished;
+  aside.translation().x() = 0.15;
+  CHECK_FALSE(analysis.check({{base, aside}}));
+  CHECK_FALSE(analysis.check({{base, finished}, {block, finished}}));
+}
+
 TEST_CASE("gravity: a fastening joint holds what contact alone does not", "[stability]") {
   const test::ScratchDir dir("stability-glued");
   Boxes b;

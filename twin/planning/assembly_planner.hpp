@@ -5,6 +5,7 @@
 // another order (if the sequence planner backtracks). The result is a plan and findings
 // for the designer.
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <set>
@@ -74,6 +75,11 @@ struct Plan {
   bool stability = false;  // every state asked whether it stands (PlannerOptions::stability)
   // How the product stands while it is built, and as the cell delivers it (build_orientation.hpp).
   std::string orientation = "as finished";
+
+  // Parts put in: a subassembly's step that sets it in place puts in none of its own.
+  std::size_t parts_placed() const {
+    return static_cast<std::size_t>(std::count_if(steps.begin(), steps.end(), [](const PlanStep& s) { return s.carried.empty(); }));
+  }
 };
 
 // How the search goes, for a person waiting: each part put in and each one taken off again.

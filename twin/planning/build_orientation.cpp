@@ -26,7 +26,7 @@ bool stands_finished(const LoadedProduct& product, const PlannerOptions& options
 }
 
 std::string parts_in(const Plan& plan, std::size_t parts) {
-  return std::to_string(plan.steps.size()) + " of " + std::to_string(parts);
+  return std::to_string(plan.parts_placed()) + " of " + std::to_string(parts);
 }
 
 }  // namespace
@@ -98,7 +98,7 @@ OrientedPlan plan_in_build_orientation(const LoadedProduct& product, SequencePla
     }
     Plan plan = plan_assembly(turned, sequence, path, each);
     tried.push_back(orientations[i].name + ": " + parts_in(plan, parts));
-    if (plan.complete || plan.steps.size() > best.plan.steps.size()) {
+    if (plan.complete || plan.parts_placed() > best.plan.parts_placed()) {
       best = {std::move(plan), orientations[i], std::move(turned)};
       best.plan.orientation = orientations[i].name;
     }

@@ -109,6 +109,14 @@ std::vector<ContactPoint> reduce(const std::vector<ContactPoint>& contacts) {
   return out;
 }
 
+// A pose as a key: its rotation and translation (the top three rows of its matrix; the first
+// twelve numbers of the 4x4 column-major storage would leave the translation out).
+std::array<double, 12> key_of(const Pose& pose) {
+  std::array<double, 12> key;
+  Eigen::Map<Eigen::Matrix<double, 3, 4>>(key.data()) = pose.affine();
+  return key;
+}
+
 }  // namespace
 
 struct StabilityAnalysis::Impl {
@@ -119,7 +127,7 @@ struct StabilityAnalysis::Impl {
   // normal the way b is pushed.
   mutable std::map<std::pair<PartIndex, PartIndex>, std::vector<ContactPoint>> pairs;
   mutable std::map<std::vector<double>, std::optional<Instability>> answers;  // check(), by state
-  // on_station(), by part and pose (its 3x4 matrix)
+  // on_station(), by part and pose (key_of)
   mutable std::map<std::pair<PartIndex, std::array<double, 12>>, std::vector<ContactPoint>> stations;
 
   const PartFacts& facts_of(PartIndex p) const {
@@ -312,9 +320,7 @@ struct StabilityAnalysis::Impl {
   // Contacts of a part with the station's surface (y = 0) where it stands at `pose`: its
   // corners that lie within the contact distance of it, in the world, pushed up.
   const std::vector<ContactPoint>& on_station(PartIndex p, const Pose& pose) const {
-    std::array<double, 12> key;
-    std::copy(pose.matrix().data(), pose.matrix().data() + 12, key.begin());
-    auto [it, made] = stations.try_emplace({p, key});
+    auto [it, made] = stations.try_emplace({p, key_of(pose)});
     if (!made || !product.meshes[p]) return it->second;
     std::vector<ContactPoint> out;
     for (const Vec3& v : product.meshes[p]->vertices) {
@@ -606,7 +612,8 @@ std::optional<Instability> StabilityAnalysis::check(const std::vector<PlacedPart
   std::vector<double> key;
   for (const auto& p : placed) {
     key.push_back(static_cast<double>(p.part));
-    key.insert(key.end(), p.pose.matrix().data(), p.pose.matrix().data() + 12);
+    const auto pose = key_of(p.pose);
+    key.insert(key.end(), pose.begin(), pose.end());
   }
   key.push_back(-1);
   for (PartIndex f : fixed) key.push_back(static_cast<double>(f));

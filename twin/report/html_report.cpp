@@ -197,8 +197,7 @@ std::string html_report(const LoadedProduct& loaded, const Plan& plan, const Rep
   const Product& product = loaded.product;
   const GltfAnimation animation = gltf_animation(loaded, plan, options.look);
   const std::string title = options.title.empty() ? product.name() : options.title;
-  std::size_t placed = 0;
-  for (const auto& step : plan.steps) placed += step.carried.empty() ? 1 : 0;
+  const std::size_t placed = plan.parts_placed();
 
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(title)
