@@ -10,6 +10,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -169,15 +170,32 @@ std::set<std::string> heard_resources(const CellObserver& observer) {
 }
 
 // The cell's processes, started in order; cell-sim first, as the others wait for it.
+// Each beats on `heartbeats` (named to children before): one whose heartbeat stops is hung.
 class RunningCell {
  public:
-  RunningCell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait) {
+  RunningCell(const CellConfig& cell, CellObserver& observer, std::chrono::milliseconds wait, HeartbeatSocket& heartbeats)
+      : heartbeats_(heartbeats) {
     for (const auto& spec : cell_processes(cell, executable_dir())) {
       processes_.push_back(std::make_unique<Process>(spec.name, spec.argv));
+      heartbeats_.watch(processes_.back()->pid());
     }
     wait_for_cell(cell, observer, wait);
   }
   ~RunningCell() { stop(); }
+
+  // Ends each process that runs but has not beaten for `silence` (its loop stuck): a run does
+  // not restart its cell, so ended() then names it as a fault, and the orders that wait for
+  // it end at their own waits rather than never.
+  void end_hung(HeartbeatSocket::Clock::duration silence) {
+    const auto stopped = heartbeats_.stopped(silence);
+    for (auto& p : processes_) {
+      const auto beat = stopped.find(p->pid());
+      if (beat == stopped.end() || p->poll() >= 0) continue;
+      std::cerr << "error: " << p->name() << " runs but " << beat->second << "; ending it" << std::endl;
+      heartbeats_.forget(p->pid());
+      p->stop(std::chrono::seconds(2));
+    }
+  }
 
   // A process that ended by itself, or nullptr.
   Process* ended() {
@@ -207,6 +225,7 @@ class RunningCell {
   }
 
  private:
+  HeartbeatSocket& heartbeats_;
   std::vector<std::unique_ptr<Process>> processes_;
 };
 
@@ -247,6 +266,7 @@ struct Order {
   int exit_code = -1;
   double sim_start = 0, sim_end = 0;
   long peak_rss_kb = 0;
+  std::string ended_why = {};  // why the twin was ended, where this cellctl ended it
 };
 
 // One order per product: ids from the product files' stems, numbered where one repeats.
@@ -277,9 +297,13 @@ void check_identities_for(const CellConfig& cell, std::size_t orders) {
 // and follows them to their ends, printing their progress. At most the deployment's
 // max_twins run at once, as in `up`'s queue; the other orders wait their turn, in order.
 // (Sixty twins at once on two cores: every new twin's endpoints discovered by every other
-// process took 20-45 s, and orders failed waiting for the cell.)
+// process took 20-45 s, and orders failed waiting for the cell.) A twin that runs but whose
+// heartbeat stops for the cell's twin_watchdog is ended, and its order fails saying so (`up`'s
+// desk starts another for it; a run has no queue to take it up). `tend`: the cell's own
+// care between the looks.
 void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Order>& orders, CellObserver& observer,
-                double wait_s, TwinIdentities& identities, TwinPool* standby = nullptr) {
+                double wait_s, TwinIdentities& identities, HeartbeatSocket& heartbeats, TwinPool* standby = nullptr,
+                const std::function<void()>& tend = {}) {
   std::set<std::string> ids;
   for (const auto& order : orders) ids.insert(order.id);
   observer.on_status([ids](const cell::OrderStatus& s) {
@@ -298,6 +322,20 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
       order.twin = identities.start(order.id, twin_argv(cell, executable_dir(), order.id, order.product, order.out,
                                                         o.sequence, o.path, cell.state_dir, wait_s))
                        .process;  // check_identities_for: there is an identity for each
+    }
+    heartbeats.watch(order.twin->pid());
+    std::cout << "order " << order.id << ": twin pid " << order.twin->pid() << std::endl;
+  };
+  const auto end_unheard_twins = [&] {
+    const auto stopped = heartbeats.past_twin_watchdog(cell.twin_watchdog);
+    for (auto& order : orders) {
+      if (!order.twin || order.exit_code >= 0) continue;
+      const auto beat = stopped.find(order.twin->pid());
+      if (beat == stopped.end()) continue;
+      order.ended_why = "its twin ran but " + beat->second + "; ended";
+      std::cerr << "error: order " << order.id << ": " << order.ended_why << std::endl;
+      heartbeats.forget(order.twin->pid());
+      order.twin->stop(std::chrono::seconds(2));
     }
   };
   const std::size_t at_once = static_cast<std::size_t>(cell.max_twins);
@@ -321,7 +359,9 @@ void run_orders(const CellConfig& cell, const SubmitOptions& o, std::vector<Orde
     }
     for (; next < orders.size() && running < at_once; ++next, ++running) start(orders[next]);
     if (running == 0 && next == orders.size()) break;
+    end_unheard_twins();
     if (standby) standby->tend();
+    if (tend) tend();
     std::this_thread::sleep_for(50ms);
   }
   observer.on_status({});
@@ -416,7 +456,11 @@ bool report_orders(const std::vector<Order>& orders, CellObserver& observer) {
   for (const auto& order : orders) {
     const auto it = statuses.find(order.id);
     std::string result = order.exit_code == 0 ? "assembled" : "failed (exit " + std::to_string(order.exit_code) + ")";
-    if (order.exit_code != 0 && it != statuses.end() && it->second.message().size() > 0) result += ": " + it->second.message().to_string();
+    if (!order.ended_why.empty()) {
+      result += ": " + order.ended_why;
+    } else if (order.exit_code != 0 && it != statuses.end() && it->second.message().size() > 0) {
+      result += ": " + it->second.message().to_string();
+    }
     table.add_row({order.id, fs::path(order.product).filename().string(), result, fixed(order.sim_start, 1),
                    fixed(order.sim_end, 1), std::to_string(order.peak_rss_kb / 1024)});
     first = std::min(first, order.sim_start);
@@ -579,7 +623,9 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     // No cellctl up on the domain (a cell of processes started by hand): the twin runs here.
     check_identities_for(cell, orders.size());
     TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
-    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities);
+    HeartbeatSocket heartbeats;
+    heartbeats.name_to_children();
+    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities, heartbeats);
     const Order& order = orders.front();
     std::cout << "twin peak RSS " << order.peak_rss_kb / 1024 << " MB\n";
     if (order.exit_code == 0) std::cout << "order " << order.id << " done: " << order.out << "/report.html, " << order.out << "/plan.json, " << order.out << "/animation.gltf\n";
@@ -735,14 +781,18 @@ void add_cell_commands(CLI::App& app, int& exit_code) {
     const RosterWriter roster(observer.participant(), cell);
     if (!events->empty()) observer.log_events_to(*events);
     const auto started = std::chrono::steady_clock::now();
+    HeartbeatSocket heartbeats;  // the cell's processes and the twins beat on it
+    heartbeats.name_to_children();
     // A twin per order stands by while the cell comes up, as `up`'s desk keeps them: an order
     // starts in a twin that has joined the cell (docs/performance.md "Twin start-up").
     TwinIdentities identities(cell.twin_identities_in_use(), observer.participant());
     TwinPool standby(twin_standby_argv(cell, executable_dir()),
                      static_cast<int>(std::min(orders.size(), static_cast<std::size_t>(cell.max_twins))), identities);
-    RunningCell running(cell, observer, std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000)));
+    const auto wait = std::chrono::milliseconds(static_cast<long>(cell_options->wait_s * 1000));
+    RunningCell running(cell, observer, wait, heartbeats);
     std::cout << "cell up on domain " << cell.domain << ", real-time factor " << cell.real_time_factor << std::endl;
-    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities, &standby);
+    run_orders(cell, *submit_options, orders, observer, cell_options->wait_s, identities, heartbeats, &standby,
+               [&] { running.end_hung(wait); });
     const bool all = report_orders(orders, observer);
     exit_code = all ? 0 : 1;
     while (Process* p = running.ended()) {  // a cell process that did not last the run is a fault

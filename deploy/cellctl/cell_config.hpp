@@ -120,7 +120,8 @@ struct CellConfig {
   // other orders wait in the cell's queue, in the order they came (docs/order-desk.md).
   int max_twins = 16;
   // `twin_watchdog:` s a twin's heartbeat (services/node/heartbeat.hpp) may stay silent before
-  // cellctl up's desk ends it as hung and starts another for its order (it counts as died).
+  // cellctl up's desk ends it as hung and starts another for its order (it counts as died);
+  // cellctl run ends it and fails its order.
   // A twin beats from its event loop and between the planner's steps; longer than its waits
   // for the cell (30 s) and its exit watchdog (15 s).
   double twin_watchdog = 60;

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <cstddef>
 #include <cstring>
 #include <stdexcept>
@@ -77,6 +79,14 @@ const std::map<pid_t, HeartbeatSocket::Clock::time_point>& HeartbeatSocket::beat
     }
   }
   return last_beat_;
+}
+
+void HeartbeatSocket::name_to_children() const { ::setenv("NOTIFY_SOCKET", name_.c_str(), 1); }
+
+std::map<pid_t, std::string> HeartbeatSocket::past_twin_watchdog(double twin_watchdog) {
+  auto out = stopped(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(twin_watchdog)));
+  for (auto& [pid, why] : out) why += ", past twin_watchdog " + std::to_string(std::lround(twin_watchdog)) + " s";
+  return out;
 }
 
 std::map<pid_t, std::string> HeartbeatSocket::stopped(Clock::duration silence) {

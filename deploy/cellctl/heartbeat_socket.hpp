@@ -24,6 +24,9 @@ class HeartbeatSocket {
 
   // The NOTIFY_SOCKET value for a child.
   const std::string& name() const { return name_; }
+  // Names it in this process's environment (NOTIFY_SOCKET): every process started from here
+  // on beats on it.
+  void name_to_children() const;
   // Beats are kept for the pids watched only (any local process may send to the socket).
   void watch(pid_t pid);
   void forget(pid_t pid);
@@ -33,6 +36,8 @@ class HeartbeatSocket {
   // Reads what came; for each watched pid that beat and then fell silent for longer than
   // `silence`, why it is taken for hung: "its heartbeat stopped 31 s ago (its loop is stuck)".
   std::map<pid_t, std::string> stopped(Clock::duration silence);
+  // stopped() past a cell's `twin_watchdog` (s), each reason saying so.
+  std::map<pid_t, std::string> past_twin_watchdog(double twin_watchdog);
 
  private:
   int fd_ = -1;

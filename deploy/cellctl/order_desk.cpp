@@ -1,7 +1,6 @@
 #include "deploy/cellctl/order_desk.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <vector>
 
 namespace cellctl {
@@ -19,12 +18,11 @@ OrderDesk::OrderDesk(const CellConfig& cell, state::CellStore& store, dds::Parti
 OrderDesk::~OrderDesk() { interrupt_all(); }
 
 void OrderDesk::end_unheard_twins() {
-  const auto stopped = heartbeats_.stopped(std::chrono::duration_cast<HeartbeatSocket::Clock::duration>(
-      std::chrono::duration<double>(cell_.twin_watchdog)));
+  const auto stopped = heartbeats_.past_twin_watchdog(cell_.twin_watchdog);
   for (auto& [id, twin] : twins_) {
     const auto beat = stopped.find(twin.process->pid());
     if (beat == stopped.end() || twin.process->poll() >= 0) continue;
-    const std::string why = beat->second + ", past twin_watchdog " + std::to_string(std::lround(cell_.twin_watchdog)) + " s";
+    const std::string& why = beat->second;
     log_("the twin of order " + id + " runs but " + why + "; ending it");
     store_.journal("twin-" + id, "unheard", id, why);
     twin.process->stop(std::chrono::seconds(2));  // found ended below, and started again as one that died

@@ -1,13 +1,12 @@
 #include "deploy/cellctl/supervisor.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 
 namespace cellctl {
 
 Supervisor::Supervisor(std::vector<ProcessSpec> specs, RestartPolicy policy, Log log)
     : policy_(policy), log_(std::move(log)) {
-  ::setenv("NOTIFY_SOCKET", heartbeats_.name().c_str(), 1);
+  heartbeats_.name_to_children();
   for (auto& spec : specs) {
     Child child{std::move(spec), nullptr, {}, {}, 0, std::chrono::steady_clock::now()};
     child.process = std::make_unique<Process>(child.spec.name, child.spec.argv);

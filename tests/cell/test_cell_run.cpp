@@ -3,12 +3,16 @@
 // domain of its own, every process ended by its id (cellctl ends the ones it starts), every
 // wait bounded. Timing is asserted in simulated time from the event log, never in wall time.
 
+#include <signal.h>
+
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include <catch2/catch.hpp>
@@ -565,6 +569,42 @@ TEST_CASE("a twin that dies mid-order: its reservations lapse, its parts leave c
   CHECK(log.find("doomed") == std::string::npos);  // nothing of the dead order in the way
   CHECK(cellctl({"down", "--domain", domain}, dir / "down.log", 30s) == 0);
   CHECK(up.wait_for_exit(20s) == 0);
+}
+
+TEST_CASE("cell run: a twin frozen during physical assembly falls silent: run ends it and fails its order, saying why",
+          "[process][cell]") {
+  test::clean_stale_dds_segments();
+  const fs::path dir = scratch("run-twin-frozen");
+  std::ofstream(dir / "cell.yaml") << read_text(kCell) << "\ntwin_watchdog: 5\n";
+  test::ChildProcess run({CELLCTL_EXE, "run", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--cell",
+                          (dir / "cell.yaml").string(), "--domain", "179", "--real-time-factor", "10", "--out",
+                          (dir / "out").string()},
+                         (dir / "run.log").string());
+  REQUIRE(test::appears(dir / "run.log", "order lego-tower: twin pid "));
+  const std::string started = read_text(dir / "run.log");
+  const pid_t twin = std::atoi(started.c_str() + started.find("twin pid ") + 9);
+  REQUIRE(twin > 0);
+  {  // Three parts in place: the twin is deep in physical assembly.
+    const auto deadline = std::chrono::steady_clock::now() + 90s;
+    std::size_t placed = 0;
+    while (placed < 3 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(50ms);
+      if (!fs::exists(dir / "out" / "cell-state")) continue;
+      const state::CellStore store(dir / "out" / "cell-state");
+      const auto parts = store.parts("lego-tower");
+      placed = static_cast<std::size_t>(std::count_if(parts.begin(), parts.end(), [](const auto& p) { return p.place == state::Place::placed; }));
+    }
+    REQUIRE(placed >= 3);
+  }
+  // SIGSTOP: alive on DDS for its lease, its loop stopped: only its heartbeat tells.
+  ::kill(twin, SIGSTOP);
+  const int code = run.wait_for_exit(60s);
+  const std::string log = read_text(dir / "run.log");
+  INFO(log);
+  CHECK(code == 1);
+  CHECK(log.find("error: order lego-tower: its twin ran but its heartbeat stopped") != std::string::npos);
+  CHECK(log.find("past twin_watchdog 5 s; ended") != std::string::npos);
+  CHECK(::kill(twin, 0) != 0);  // ended, not left stopped
 }
 
 namespace {
