@@ -264,7 +264,7 @@ std::optional<Collision> AssemblyScene::simulate_grasps(PartIndex part, Trajecto
   // closed on air: each side and closing axis once, the fingers half-way in.
   const Grasp own = trajectory.grasp;
   for (const Grasp& centred : all) {
-    if (centred.label.find(", shallow") != std::string::npos || centred.label.find(", deep") != std::string::npos) continue;
+    if (centred.reach != Grasp::Reach::half) continue;
     for (const Grasp& g : off_centre(part, centred)) {
       if (holds(part, g) && !run(g)) return std::nullopt;
     }

@@ -63,14 +63,14 @@ std::vector<Grasp> grasps_for(const Eigen::AlignedBox3d& box, const Pose& final_
       // miss half-way down: finger_contact.hpp).
       const double half = std::min(gripper.finger_length, depth / 2), quarter = std::min(gripper.finger_length, depth / 4);
       const double deep = std::min(gripper.finger_length, depth - kDeepGraspClearance);
-      const auto add = [&](double reach, const char* variant) {
+      const auto add = [&](double reach, Grasp::Reach kind, const char* variant) {
         // The palm stands off the part's face so that the fingertips reach `reach` into it.
         world.translation() = box.center() + y * (depth / 2 + gripper.finger_length - reach + gripper.palm_thickness / 2);
-        out.push_back({final_pose.inverse() * world, size[close], label + variant});
+        out.push_back({final_pose.inverse() * world, size[close], label + variant, kind});
       };
-      add(half, "");
-      if (quarter < half) add(quarter, ", shallow");
-      if (deep > half + kDeepGraspClearance) add(deep, ", deep");
+      add(half, Grasp::Reach::half, "");
+      if (quarter < half) add(quarter, Grasp::Reach::shallow, ", shallow");
+      if (deep > half + kDeepGraspClearance) add(deep, Grasp::Reach::deep, ", deep");
     }
   }
   return out;

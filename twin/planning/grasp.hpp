@@ -14,9 +14,12 @@
 namespace twin {
 
 struct Grasp {
+  // How far the fingers reach into the part (grasps_for): half-way, a quarter, or as deep as they can.
+  enum class Reach { half, shallow, deep };
   Pose gripper = Pose::Identity();  // the gripper's frame (services/node/gripper.hpp) in the part's frame
   double opening = 0;               // m between the fingers: the part's width across them
   std::string label;                // e.g. "across x from above": the closing axis, the carriage's side
+  Reach reach = Reach::half;
 };
 
 // The grasps on a part whose box in the finished product is `box` (world axes; the part's
