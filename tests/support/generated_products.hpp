@@ -264,4 +264,15 @@ inline Generated stacked_blocks(std::uint32_t seed) {
   return {make.take(), Expect::either, recipe.str()};
 }
 
+// Stacked blocks whose lowest two are a subassembly: built aside, set in place as one, the
+// others stacked on it after. What stood aside must stand where it is set, and the replay must
+// see it so (gravity's memory of a state once left the parts' translation out, and a
+// subassembly set in place was taken to stand on the station where it was built).
+inline Generated stacked_on_a_subassembly(std::uint32_t seed) {
+  Generated g = stacked_blocks(seed);
+  for (twin::PartIndex p : {0, 1}) g.product.product.parts()[p].subassembly = "lower";
+  g.recipe += "; b0 and b1 a subassembly";
+  return g;
+}
+
 }  // namespace test

@@ -34,7 +34,7 @@ std::string join(const std::vector<std::string>& names, const std::string& separ
 class Search {
  public:
   Search(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path, const PlannerOptions& options,
-         const StabilityAnalysis* stability)
+         const Gravity* stability)
       : product_(product), sequence_(sequence), path_(path), options_(options),
         scene_(product, options.collision, options.gripper), assembled_(product.product.parts().size(), false),
         stability_(options.stability ? stability : nullptr) {}
@@ -589,7 +589,7 @@ class Search {
   std::size_t most_placeable_ = 0;  // no plan holds more parts (fewest_left_out)
   bool at_most_placeable_ = false;  // the search stopped there
   std::optional<std::pair<PartIndex, std::size_t>> stopped_at_;  // the part and step a sequence ended at
-  const StabilityAnalysis* stability_;
+  const Gravity* stability_;
   std::map<std::vector<bool>, Standing> standing_;  // by the parts in place, the new one among them
   std::map<PartIndex, std::vector<std::vector<bool>>> blocked_among_;  // parts in place where a part found no way
   std::map<PartIndex, std::vector<Way>> ways_;                       // and where it found one
@@ -662,7 +662,7 @@ void verify(const LoadedProduct& product, Plan& plan, const PlannerOptions& opti
 // fixtures (PlannerOptions::fixtures) and only if every part goes in; a partial plan still
 // tells the designer more than one that stopped at the first part that would fall.
 Plan plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
-                        const PlannerOptions& options, const StabilityAnalysis& stability, double time_limit) {
+                        const PlannerOptions& options, const Gravity& stability, double time_limit) {
   PlannerOptions loose = options;
   loose.stability = false;
   loose.time_limit = time_limit;
@@ -679,7 +679,7 @@ Plan plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence,
     for (std::size_t c = 0; c < connections.size(); ++c) {
       fastened[c] = connections[c].joint.fastens() && in[connections[c].part1] && in[connections[c].part2];
     }
-    if (const auto falls = stability.check(placed, held, fastened)) {
+    if (const auto falls = stability.check(placed, held, fastened, std::nullopt)) {
       plan.steps[i].fixture = falls->parts;
       held.insert(held.end(), falls->parts.begin(), falls->parts.end());
       plan.findings.push_back({"fixture",
@@ -691,7 +691,7 @@ Plan plan_with_fixtures(const LoadedProduct& product, SequencePlanner& sequence,
     // Standing once fastened, not before: the arm holds it until then.
     std::vector<bool> before = fastened;
     for (std::size_t c : product.product.connections_of(part)) before[c] = false;
-    plan.steps[i].hold = before != fastened && stability.check(placed, held, before).has_value();
+    plan.steps[i].hold = before != fastened && stability.check(placed, held, before, std::nullopt).has_value();
   }
   plan.stability = options.stability;
   // An order that needs no fixture after all stands as it is.
@@ -706,19 +706,20 @@ Plan plan_assembly(const LoadedProduct& product, SequencePlanner& sequence, Path
                    const PlannerOptions& options) {
   // One analysis for the search and the replay: contacts between parts are found once.
   const StabilityAnalysis stability(product, options.stand);
+  const Gravity& gravity = options.gravity ? *options.gravity : stability;
   Plan plan;
   if (!subassemblies_of(product.product).empty()) {
     if (!options.given.empty()) throw std::logic_error("planning on from given steps of a product with subassemblies");
-    plan = plan_with_subassemblies(product, sequence, path, options);
+    plan = plan_with_subassemblies(product, sequence, path, options, stability);
   } else {
     const auto start = std::chrono::steady_clock::now();
-    Search search(product, sequence, path, options, &stability);
+    Search search(product, sequence, path, options, &gravity);
     plan = search.run();
     const double left =
         options.time_limit - std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const bool stopped = options.stop && options.stop();
     if (!plan.complete && search.refused_for_gravity() && (options.time_limit <= 0 || left > 0) && !stopped) {
-      Plan fixtures = plan_with_fixtures(product, sequence, path, options, stability, options.time_limit <= 0 ? 0 : left);
+      Plan fixtures = plan_with_fixtures(product, sequence, path, options, gravity, options.time_limit <= 0 ? 0 : left);
       if (fixtures.complete || fixtures.steps.size() > plan.steps.size()) plan = std::move(fixtures);
     }
   }

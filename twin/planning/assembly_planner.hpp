@@ -129,6 +129,9 @@ struct PlannerOptions {
   // is not put in there, and the search looks for an order that puts supports first.
   bool stability = true;
   StabilityOptions stand;
+  // Asked instead of the product's own StabilityAnalysis where set (the level of a product
+  // whose subassemblies are single parts asks it of their members: subassembly_planner.cpp).
+  const Gravity* gravity = nullptr;
   // The cell can hold a part that stands on nothing yet in a fixture: where no order stands,
   // such a plan is complete with 'fixture' findings; without, it is not.
   bool fixtures = false;

@@ -517,7 +517,8 @@ class Replay {
   }
 
   // Whether the parts in place stand once the arm has let go of the step's part: its
-  // fastenings made if the step holds it until they are, else not yet.
+  // fastenings made if the step holds it until they are, else not yet. Those between the
+  // members of a subassembly it sets in place were made when it was built.
   std::optional<Violation> falls_after(const PlanStep& step) {
     if (!stability_) return std::nullopt;
     const auto& connections = product_.product.connections();
@@ -525,11 +526,15 @@ class Replay {
     for (PartIndex p = 0; p < placed_.size(); ++p) {
       if (placed_[p]) placed.push_back({p, *placed_[p]});
     }
+    std::vector<bool> moved(placed_.size(), false);
+    moved[step.part] = true;
+    for (PartIndex m : step.carried) moved[m] = true;
     std::vector<bool> fastened(connections.size(), false);
     for (std::size_t c = 0; c < connections.size(); ++c) {
       const Connection& k = connections[c];
       fastened[c] = k.joint.fastens() && placed_[k.part1] && placed_[k.part2];
-      if (!step.hold && (k.part1 == step.part || k.part2 == step.part)) fastened[c] = false;
+      const bool made_now = moved[k.part1] != moved[k.part2];
+      if (!step.hold && made_now) fastened[c] = false;
     }
     const auto falls = stability_->check(placed, held_, fastened);
     if (!falls) return std::nullopt;

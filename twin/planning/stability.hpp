@@ -40,7 +40,17 @@ struct PlacedPart {
   Pose pose = Pose::Identity();
 };
 
-class StabilityAnalysis {
+// What the planner asks of gravity: whether the parts stand (StabilityAnalysis::check says
+// how). A product planned with its subassemblies as single parts asks it of their members
+// (subassembly_planner.cpp): unfastened members do not stand as one rigid body.
+class Gravity {
+ public:
+  virtual ~Gravity() = default;
+  virtual std::optional<Instability> check(const std::vector<PlacedPart>& placed, const std::vector<PartIndex>& fixed,
+                                           const std::vector<bool>& fastened, std::optional<PartIndex> added) const = 0;
+};
+
+class StabilityAnalysis : public Gravity {
  public:
   StabilityAnalysis(const LoadedProduct& product, StabilityOptions options = {});
   ~StabilityAnalysis();
@@ -59,7 +69,7 @@ class StabilityAnalysis {
   // leaning on them nothing else need be asked.
   std::optional<Instability> check(const std::vector<PlacedPart>& placed, const std::vector<PartIndex>& fixed = {},
                                    const std::vector<bool>& fastened = {},
-                                   std::optional<PartIndex> added = std::nullopt) const;
+                                   std::optional<PartIndex> added = std::nullopt) const override;
 
  private:
   struct State;

@@ -1,7 +1,9 @@
 #include "twin/planning/subassembly_planner.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <map>
+#include <optional>
 
 #include "twin/model/source_ref.hpp"
 
@@ -86,6 +88,7 @@ LoadedProduct product_of_units(const LoadedProduct& product, const std::vector<S
       for (const auto& [end, interface] : {std::pair{c.part1, c.interface1}, std::pair{c.part2, c.interface2}}) {
         if (member_of.count(end) && member_of[end] == &s) {
           unit.own_interfaces[parts[end].name + "/" + interface] = *product.product.interface_of(end, interface);
+          if (const Joint* joint = product.product.joint_of(end, interface)) unit.own_joints[parts[end].name + "/" + interface] = *joint;
         }
       }
     }
@@ -224,8 +227,73 @@ PlanLevels plan_levels(const LoadedProduct& product) {
   return out;
 }
 
+namespace {
+
+// Gravity at the product's level, where each subassembly is one part, asked of the product's
+// own parts: a subassembly's members where it stands, fastened to each other where their
+// joints fasten (made when it was built), and not one rigid body where they do not (a block
+// on a plate stays a block on a plate). What would move is named by the level's parts.
+class MembersGravity : public Gravity {
+ public:
+  MembersGravity(const LoadedProduct& product, const PlanLevel& level, const std::vector<Subassembly>& subassemblies,
+                 const StabilityAnalysis& analysis)
+      : product_(product), level_(level), analysis_(analysis) {
+    level_part_of_.assign(product.product.parts().size(), 0);
+    members_.resize(level.origin.size());
+    for (PartIndex u = 0; u < level.origin.size(); ++u) {
+      const int s = level.unit[u];
+      members_[u] = s >= 0 ? subassemblies[static_cast<std::size_t>(s)].members : std::vector<PartIndex>{level.origin[u]};
+      for (PartIndex m : members_[u]) level_part_of_[m] = u;
+    }
+    // The level's connections are the product's between parts of two of its parts, in order.
+    int next = 0;
+    for (const Connection& c : product.product.connections()) {
+      level_connection_.push_back(level_part_of_[c.part1] == level_part_of_[c.part2] ? -1 : next++);
+    }
+  }
+
+  std::optional<Instability> check(const std::vector<PlacedPart>& placed, const std::vector<PartIndex>& fixed,
+                                   const std::vector<bool>& fastened, std::optional<PartIndex> added) const override {
+    const auto& parts = product_.product.parts();
+    std::vector<PlacedPart> members;
+    for (const PlacedPart& u : placed) {
+      const Pose moved = u.pose * parts[level_.origin[u.part]].final_pose.inverse();
+      for (PartIndex m : members_[u.part]) members.push_back({m, moved * parts[m].final_pose});
+    }
+    std::vector<PartIndex> held;
+    for (PartIndex u : fixed) held.insert(held.end(), members_[u].begin(), members_[u].end());
+    const auto& connections = product_.product.connections();
+    std::vector<bool> made(connections.size());
+    for (std::size_t c = 0; c < connections.size(); ++c) {
+      const int k = level_connection_[c];
+      made[c] = k < 0 ? connections[c].joint.fastens() : static_cast<std::size_t>(k) < fastened.size() && fastened[k];
+    }
+    // A new part of one member is asked first on its own; a subassembly's members, together.
+    std::optional<PartIndex> new_part;
+    if (added && members_[*added].size() == 1) new_part = members_[*added].front();
+    auto falls = analysis_.check(members, held, made, new_part);
+    if (!falls) return falls;
+    std::vector<PartIndex> group;
+    for (PartIndex m : falls->parts) {
+      if (std::find(group.begin(), group.end(), level_part_of_[m]) == group.end()) group.push_back(level_part_of_[m]);
+    }
+    falls->parts = std::move(group);
+    return falls;
+  }
+
+ private:
+  const LoadedProduct& product_;
+  const PlanLevel& level_;
+  const StabilityAnalysis& analysis_;
+  std::vector<std::vector<PartIndex>> members_;  // per part of the level
+  std::vector<PartIndex> level_part_of_;         // per part of the product
+  std::vector<int> level_connection_;            // per connection of the product; -1: inside a subassembly
+};
+
+}  // namespace
+
 Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
-                             const PlannerOptions& options) {
+                             const PlannerOptions& options, const StabilityAnalysis& stability) {
   const PlanLevels levels = plan_levels(product);
   Plan plan;
   plan.complete = true;
@@ -237,6 +305,9 @@ Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequ
   PlannerOptions each = options;
   each.verify = false;
   for (const PlanLevel& level : levels.levels) {
+    std::optional<MembersGravity> members;
+    if (level.subassembly.empty()) members.emplace(product, level, levels.subassemblies, stability);
+    each.gravity = members ? &*members : nullptr;
     Plan own = plan_assembly(level.product, sequence, path, each);
     for (PlanStep step : own.steps) {
       step.allowed = mapped(step.allowed, level.origin);

@@ -52,7 +52,8 @@ struct PlanLevels {
 
 PlanLevels plan_levels(const LoadedProduct& product);
 
+// `stability`: the product's own, asked at the product's level of the subassemblies' members.
 Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequence, PathPlanner& path,
-                             const PlannerOptions& options);
+                             const PlannerOptions& options, const StabilityAnalysis& stability);
 
 }  // namespace twin
