@@ -281,6 +281,9 @@ class MembersGravity : public Gravity {
     return falls;
   }
 
+  // The product's parts a part of the level stands for: a subassembly's members, or itself.
+  const std::vector<PartIndex>& members(PartIndex level_part) const { return members_[level_part]; }
+
  private:
   const LoadedProduct& product_;
   const PlanLevel& level_;
@@ -311,7 +314,13 @@ Plan plan_with_subassemblies(const LoadedProduct& product, SequencePlanner& sequ
     Plan own = plan_assembly(level.product, sequence, path, each);
     for (PlanStep step : own.steps) {
       step.allowed = mapped(step.allowed, level.origin);
-      step.fixture = mapped(step.fixture, level.origin);
+      if (members) {  // a fixture that holds a subassembly holds its members, as its gravity asked
+        std::vector<PartIndex> held;
+        for (PartIndex u : step.fixture) held.insert(held.end(), members->members(u).begin(), members->members(u).end());
+        step.fixture = std::move(held);
+      } else {
+        step.fixture = mapped(step.fixture, level.origin);
+      }
       if (!level.subassembly.empty()) {
         step.subassembly = level.subassembly;
       } else if (const int u = level.unit[step.part]; u >= 0) {
