@@ -7,6 +7,7 @@
 #include <tiny_gltf.h>
 #include <unistd.h>
 
+#include "tests/support/generated_products.hpp"
 #include "tests/twin/test_support.hpp"
 #include "twin/description/automationml/precedence_writer.hpp"
 #include "twin/planning/precedence_suggestions.hpp"
@@ -354,4 +355,29 @@ TEST_CASE("subassemblies: one whose base cannot be gripped clear of its other me
            f.message.find("grasps of its base would put the gripper in its other members") != std::string::npos;
   }));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("subassemblies: a joint declared on a member's side fastens the whole where it is set", "[planning][subassembly]") {
+  // An arm glued onto a pier's edge, overhanging it by half its length, a weight on the arm:
+  // arm and weight a subassembly, the glue declared on the arm's interface only. Set in place
+  // and held until the glue is made, it stands. (The product's level once took the unit's
+  // interfaces from its members but not their joints: it knew no glue, and nothing stood.)
+  test::ProductMaker make("glued-overhang");
+  make.part("pier", test::stepped_post({{0, 0.020, 0.020, 0.020}}, twin::Vec3::Zero()));
+  make.part("arm", test::stepped_post({{0, 0.010, 0.020, 0.015}}, twin::Vec3(0.030, 0.020, 0)));
+  make.part("weight", test::stepped_post({{0, 0.010, 0.010, 0.010}}, twin::Vec3(0.035, 0.030, 0)));
+  make.link("pier", "arm", "glue");  // the joint on the arm's side
+  make.link("arm", "weight");
+  twin::LoadedProduct product = make.take();
+  for (const char* member : {"arm", "weight"}) product.product.parts()[*product.product.find_part(member)].subassembly = "cantilever";
+  const twin::Plan plan = plan_of(product, twin::PlannerOptions{});  // a cell without fixtures
+  std::string findings;
+  for (const auto& f : plan.findings) findings += f.kind + ": " + f.message + "\n";
+  INFO(findings);
+  REQUIRE(plan.complete);
+  CHECK(plan.verification.passed);
+  const auto inserted = std::find_if(plan.steps.begin(), plan.steps.end(), [](const twin::PlanStep& s) { return !s.carried.empty(); });
+  REQUIRE(inserted != plan.steps.end());
+  CHECK(inserted->hold);  // the arm keeps it until the glue is made
+  CHECK(inserted->fixture.empty());
 }
