@@ -104,8 +104,9 @@ class AssemblyScene {
   // Runs the trajectory with its own grasp, then with the part's other grasps for its
   // direction, then with each of them beside the part's centre (off_centre_grasps, grasp.hpp),
   // and keeps the first that is free of collisions through insertion and retreat. Where none
-  // is, the trajectory keeps its own grasp and the answer is its collision (or, with no grasp at all, one of phase "grasp"). With `known`, a grasp whose
-  // collision recurs is not run again, and what is found is remembered there.
+  // is, the trajectory keeps its own grasp and the answer is its collision (or, with no grasp
+  // at all, one of phase "grasp"). With `known`, a grasp whose collision recurs is not run
+  // again, and what is found is remembered there.
   std::optional<Collision> simulate_grasps(PartIndex part, Trajectory& trajectory, KnownCollisions* known = nullptr) const;
 
   // The least room the part, and the gripper holding it, have on the trajectory's way in
