@@ -143,7 +143,7 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
       ids.push_back(resource["id"]);
       CHECK(resource["alive"] == true);
     }
-    for (const std::string id : {"station-1", "arm-1", "mobile-robot-1", "buffer-1", "buffer-2"}) {
+    for (const std::string& id : test::kDefaultCellResources) {
       CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
     }
     CHECK(state["domain"] == 175);

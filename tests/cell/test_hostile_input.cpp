@@ -36,8 +36,6 @@ constexpr bool kUnderSanitizer = true;
 constexpr bool kUnderSanitizer = false;
 #endif
 
-const std::string kLego = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
-const std::vector<std::string> kResources{"station-1", "arm-1", "mobile-robot-1", "buffer-1", "buffer-2"};
 
 cell::Pose pose(double x, double y, double z, double qw = 1, double qx = 0, double qy = 0, double qz = 0) {
   cell::Pose p;
@@ -85,7 +83,7 @@ class HostileCell {
     sim_requests_ = std::make_unique<dds::Writer<cell::SimRequest, cell::SimRequestPubSubType>>(
         intruder_, "cell/sim/requests", dds::TopicKind::events);
     const bool all_up = wait(60s, [&] {
-      for (const auto& id : kResources) {
+      for (const auto& id : test::kDefaultCellResources) {
         if (!capability_.count(id)) return false;
       }
       return true;
@@ -189,7 +187,7 @@ class HostileCell {
 
   // A normal order on the same cell, to its end: whether it was assembled.
   bool order_succeeds(const std::string& order) {
-    const int code = test::cellctl({"submit", kLego, "--domain", domain_, "--order", order, "--out",
+    const int code = test::cellctl({"submit", test::kLegoTower, "--domain", domain_, "--order", order, "--out",
                                     (dir_ / order).string()},
                                    dir_ / (order + ".log"));
     INFO(test::read_text(dir_ / (order + ".log")));
@@ -199,7 +197,7 @@ class HostileCell {
   // A normal order started in the background (ended by its id at the end of the test).
   std::unique_ptr<test::ChildProcess> start_order(const std::string& order) {
     return std::make_unique<test::ChildProcess>(
-        std::vector<std::string>{CELLCTL_EXE, "submit", kLego, "--domain", domain_, "--order", order, "--out",
+        std::vector<std::string>{CELLCTL_EXE, "submit", test::kLegoTower, "--domain", domain_, "--order", order, "--out",
                                  (dir_ / order).string()},
         (dir_ / (order + ".log")).string());
   }

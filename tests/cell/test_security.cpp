@@ -33,9 +33,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-const std::string kLego = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
-const std::vector<std::string> kResources{"station-1", "arm-1", "mobile-robot-1", "buffer-1", "buffer-2"};
-
 unsigned mode_of(const fs::path& p) {
   struct stat st {};
   REQUIRE(::stat(p.c_str(), &st) == 0);
@@ -185,7 +182,7 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
   Sightings trusted_sees(trusted);
   {
     INFO(up_log());
-    REQUIRE(trusted_sees.wait_for(kResources, 60s));
+    REQUIRE(trusted_sees.wait_for(test::kDefaultCellResources, 60s));
   }
 
   {  // A participant without a certificate discovers nothing, and its commands reach nobody.
@@ -403,7 +400,7 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
   }
 
   // Whatever was tried, the cell assembles an order of a trusted submitter.
-  const int order = test::cellctl({"submit", kLego, "--domain", domain, "--security", pki.string(), "--order", "after",
+  const int order = test::cellctl({"submit", test::kLegoTower, "--domain", domain, "--security", pki.string(), "--order", "after",
                                    "--out", (dir / "after").string()},
                                   dir / "after.log");
   INFO(test::read_text(dir / "after.log") << up_log());
@@ -544,9 +541,9 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   };
 
   // While oem-a's first order runs, its second within the minute is refused.
-  test::ChildProcess tower(args("oem-a", kLego, "tower"), (dir / "tower.log").string());
+  test::ChildProcess tower(args("oem-a", test::kLegoTower, "tower"), (dir / "tower.log").string());
   REQUIRE(test::appears(dir / "tower.log", "order oem-a-tower accepted", 60s));
-  CHECK(refused("again", submit("oem-a", kLego, "again"), "the desk takes 1 orders a minute from a client") == 1);
+  CHECK(refused("again", submit("oem-a", test::kLegoTower, "again"), "the desk takes 1 orders a minute from a client") == 1);
   const int lego = tower.wait_for_exit(120s);
   {
     INFO(test::read_text(dir / "tower.log") << test::read_text(dir / "up.log"));
@@ -576,7 +573,7 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
                                                                          dds::TopicKind::events);
     REQUIRE(chunks.wait_for_readers(1, 20s));
     REQUIRE(orders.wait_for_readers(1, 20s));
-    const std::string bytes = cellctl::read_file_bytes(kLego);
+    const std::string bytes = cellctl::read_file_bytes(test::kLegoTower);
     REQUIRE(cellctl::send_file(chunks, "tampered", "lego-tower.aml", bytes, std::chrono::steady_clock::now() + 20s));
     REQUIRE(chunks.wait_for_acknowledgments(20s));
     cell::OrderRequest request;
@@ -606,7 +603,7 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
   // An order under way in the cell (one its desk did not take: no twin of the desk runs it)
   // makes the cell full at one: oem-e's order is refused with the reason, and the desk stays.
   state::CellStore(dir / "state").set_order("placed-elsewhere", "PHYSICAL_ASSEMBLY");
-  CHECK(refused("busy", submit("oem-e", kLego, "busy"), "the cell has 1 orders queued or under way, its limit (desk: max_orders); try again later") == 1);
+  CHECK(refused("busy", submit("oem-e", test::kLegoTower, "busy"), "the cell has 1 orders queued or under way, its limit (desk: max_orders); try again later") == 1);
   CHECK_FALSE(fs::exists(dir / "state" / "desk" / "oem-e" / "busy"));
 
   // oem-b's certificate reads its own answers, not oem-a's, nor the cell's order status.

@@ -9,10 +9,9 @@
 #include "sim/mesh/mesh_disk_cache.hpp"
 #include "sim/mesh/triangle_bvh.hpp"
 #include "tests/support/meshes.hpp"
+#include "tests/support/paths.hpp"
 
 namespace {
-
-std::filesystem::path products(const std::string& relative) { return std::filesystem::path(PRODUCTS_DIR) / relative; }
 
 sim::Pose at(double x, double y, double z) {
   sim::Pose p = sim::Pose::Identity();
@@ -68,11 +67,11 @@ TEST_CASE("a turning body is checked along its rotation", "[collision]") {
 TEST_CASE("Cranfield: a peg passes down through its hole, and 1 mm to the side it collides", "[collision][cranfield]") {
   sim::MeshCache meshes;
   sim::CollisionWorld world;
-  world.add_static_mesh("back", meshes.get(products("cranfield/meshes/faceplate.obj")), at(0, 0, 0));
+  world.add_static_mesh("back", meshes.get(test::product("cranfield/meshes/faceplate.obj")), at(0, 0, 0));
   for (const char* mesh : {"square_peg.obj", "round_peg.obj"}) {
     INFO(mesh);
     sim::MovingBody peg;
-    peg.add_mesh("part", *meshes.get(products(std::string("cranfield/meshes/") + mesh)), sim::Pose::Identity(),
+    peg.add_mesh("part", *meshes.get(test::product(std::string("cranfield/meshes/") + mesh)), sim::Pose::Identity(),
                  world.options().shape_margin);
     // The square_left hole for the square peg, the shaft hole for the round one.
     const double hx = std::string(mesh) == "square_peg.obj" ? -0.040 : 0.0;
@@ -92,10 +91,10 @@ TEST_CASE("Cranfield: a peg passes down through its hole, and 1 mm to the side i
 TEST_CASE("Lego: a brick slides onto a brick and sits on it", "[collision][lego]") {
   sim::MeshCache meshes;
   sim::CollisionWorld world;
-  const auto brick = meshes.get(products("lego-tower/meshes/brick_2x4.obj"));
+  const auto brick = meshes.get(test::product("lego-tower/meshes/brick_2x4.obj"));
   world.add_static_mesh("below", brick, at(0, 0, 0));
   sim::MovingBody moving;
-  moving.add_mesh("part", *meshes.get(products("lego-tower/meshes/brick_2x2.obj")), sim::Pose::Identity(),
+  moving.add_mesh("part", *meshes.get(test::product("lego-tower/meshes/brick_2x2.obj")), sim::Pose::Identity(),
                   world.options().shape_margin);
   CHECK_FALSE(world.sweep(moving, at(0.1, 0.0096, 0), at(0.004, 0.0096, 0)));  // slides along the top
   CHECK_FALSE(world.sweep(moving, at(0.004, 0.1, 0), at(0.004, 0.0096, 0)));   // comes down onto it
@@ -326,9 +325,9 @@ TEST_CASE("clearance: how near a body comes, box to box, peg to hole and frame t
   SECTION("a round peg in its hole in Cranfield's plate: the play around it") {
     sim::MeshCache meshes;
     sim::CollisionWorld plate;
-    plate.add_static_mesh("back", meshes.get(products("cranfield/meshes/faceplate.obj")), at(0, 0, 0));
+    plate.add_static_mesh("back", meshes.get(test::product("cranfield/meshes/faceplate.obj")), at(0, 0, 0));
     sim::MovingBody peg;
-    peg.add_mesh("part", *meshes.get(products("cranfield/meshes/round_peg.obj")), sim::Pose::Identity(),
+    peg.add_mesh("part", *meshes.get(test::product("cranfield/meshes/round_peg.obj")), sim::Pose::Identity(),
                  plate.options().shape_margin);
     const auto in_hole = plate.nearest(peg, at(0, 0.005, 0.014), 0.01);
     REQUIRE(in_hole);

@@ -7,25 +7,21 @@
 
 #include "sim/mesh/mesh_disk_cache.hpp"
 #include "sim/mesh/triangle_mesh.hpp"
-
-namespace {
-std::filesystem::path data(const std::string& relative) { return std::filesystem::path(TEST_DATA_DIR) / relative; }
-std::filesystem::path products(const std::string& relative) { return std::filesystem::path(PRODUCTS_DIR) / relative; }
-}  // namespace
+#include "tests/support/paths.hpp"
 
 TEST_CASE("meshes load from OBJ and STL in metres", "[mesh]") {
-  const auto plate = sim::load_mesh(data("good/meshes/plate.obj"));
+  const auto plate = sim::load_mesh(test::data("good/meshes/plate.obj"));
   CHECK(plate->triangles.size() == 12);
   CHECK(plate->bounds.min().isApprox(Eigen::Vector3d(-0.02, 0, -0.02), 1e-6));
   CHECK(plate->bounds.max().isApprox(Eigen::Vector3d(0.02, 0.01, 0.02), 1e-6));
 
-  const auto block = sim::load_mesh(data("good/meshes/block.stl"));
+  const auto block = sim::load_mesh(test::data("good/meshes/block.stl"));
   CHECK(block->triangles.size() == 12);
   CHECK(block->bounds.sizes().isApprox(Eigen::Vector3d(0.01, 0.01, 0.01), 1e-6));
 }
 
 TEST_CASE("a mesh's objects are kept apart as convex pieces", "[mesh]") {
-  const auto faceplate = sim::load_mesh(products("cranfield/meshes/faceplate.obj"));
+  const auto faceplate = sim::load_mesh(test::product("cranfield/meshes/faceplate.obj"));
   // 5 holes of 32 ring pieces each, plus the solid grid cells around them.
   CHECK(faceplate->pieces.size() > 5 * 32);
   CHECK(faceplate->bounds.sizes().isApprox(Eigen::Vector3d(0.240, 0.012, 0.180), 1e-6));
@@ -36,7 +32,7 @@ TEST_CASE("a mesh's objects are kept apart as convex pieces", "[mesh]") {
 
 TEST_CASE("a piece's hull is made of its outer corners only", "[mesh]") {
   // A bearing: a ring whose bore's vertices lie inside its hull.
-  const auto bearing = sim::load_mesh(data("planning/shaft-bearing/meshes/bearing.obj"), 1e-3);
+  const auto bearing = sim::load_mesh(test::data("planning/shaft-bearing/meshes/bearing.obj"), 1e-3);
   REQUIRE(bearing->pieces.size() == 1);
   REQUIRE(bearing->hull_corners.size() == 1);
   const auto& corners = bearing->hull_corners[0];
@@ -52,17 +48,17 @@ TEST_CASE("a piece's hull is made of its outer corners only", "[mesh]") {
     CHECK(Eigen::Vector2d(d.x(), d.z()).norm() > inner + 1e-4);  // none from the bore
   }
   // A box: all eight.
-  const auto block = sim::load_mesh(data("planning/messy/meshes/flipped_block_mm.obj"), 1e-3);
+  const auto block = sim::load_mesh(test::data("planning/messy/meshes/flipped_block_mm.obj"), 1e-3);
   CHECK(block->hull_corners.at(0).size() == 8);
 }
 
 TEST_CASE("a file that is not a mesh is a MeshError", "[mesh]") {
-  CHECK_THROWS_AS(sim::load_mesh(data("bad/meshes/garbage.obj")), sim::MeshError);
-  CHECK_THROWS_AS(sim::load_mesh(data("bad/meshes/none.obj")), sim::MeshError);
+  CHECK_THROWS_AS(sim::load_mesh(test::data("bad/meshes/garbage.obj")), sim::MeshError);
+  CHECK_THROWS_AS(sim::load_mesh(test::data("bad/meshes/none.obj")), sim::MeshError);
 }
 
 TEST_CASE("a CAD export in millimetres: unwelded binary STL, scaled to metres, welded, known convex", "[mesh]") {
-  const auto block = sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3);
+  const auto block = sim::load_mesh(test::data("planning/units/meshes/block_mm.stl"), 1e-3);
   CHECK(block->triangles.size() == 12);
   CHECK(block->vertices.size() == 8);  // 36 corners as written, 8 once welded
   CHECK(block->bounds.min().isApprox(Eigen::Vector3d(-0.01, 0, -0.01), 1e-6));
@@ -70,20 +66,20 @@ TEST_CASE("a CAD export in millimetres: unwelded binary STL, scaled to metres, w
   CHECK(block->convex);
 
   sim::MeshCache cache;  // a file at two scales is two meshes
-  CHECK(cache.get(data("planning/units/meshes/block_mm.stl"), 1e-3)->bounds.sizes().x() == Approx(0.02));
-  CHECK(cache.get(data("planning/units/meshes/block_mm.stl"))->bounds.sizes().x() == Approx(20));
+  CHECK(cache.get(test::data("planning/units/meshes/block_mm.stl"), 1e-3)->bounds.sizes().x() == Approx(0.02));
+  CHECK(cache.get(test::data("planning/units/meshes/block_mm.stl"))->bounds.sizes().x() == Approx(20));
   CHECK(cache.size() == 2);
 }
 
 TEST_CASE("convexity: a box is convex, a frame of one piece and an open box are not", "[mesh]") {
-  CHECK(sim::load_mesh(data("planning/backtrack/meshes/block.obj"))->convex);
-  CHECK_FALSE(sim::load_mesh(data("planning/lipped-box/meshes/wall_left.obj"))->convex);
-  CHECK_FALSE(sim::load_mesh(products("cranfield/meshes/faceplate.obj"))->convex);  // many pieces
+  CHECK(sim::load_mesh(test::data("planning/backtrack/meshes/block.obj"))->convex);
+  CHECK_FALSE(sim::load_mesh(test::data("planning/lipped-box/meshes/wall_left.obj"))->convex);
+  CHECK_FALSE(sim::load_mesh(test::product("cranfield/meshes/faceplate.obj"))->convex);  // many pieces
 }
 
 TEST_CASE("a careless export: degenerate and duplicate triangles are dropped, open edges counted, all said",
           "[mesh][repairs]") {
-  const auto block = sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3);
+  const auto block = sim::load_mesh(test::data("planning/messy/meshes/open_block_mm.stl"), 1e-3);
   CHECK(block->triangles.size() == 10);  // 12 written: a duplicate and a sliver dropped
   CHECK(block->repairs.degenerate == 1);
   CHECK(block->repairs.duplicate == 1);
@@ -92,12 +88,12 @@ TEST_CASE("a careless export: degenerate and duplicate triangles are dropped, op
   CHECK_FALSE(block->convex);  // open: no volume to compare
   CHECK(block->repairs.describe() ==
         "1 degenerate triangle dropped; 1 duplicate triangle dropped; 4 open edges (the mesh is not closed)");
-  CHECK_FALSE(sim::load_mesh(data("planning/units/meshes/block_mm.stl"), 1e-3)->repairs.any());
+  CHECK_FALSE(sim::load_mesh(test::data("planning/units/meshes/block_mm.stl"), 1e-3)->repairs.any());
 }
 
 TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split there, and the mesh is closed",
           "[mesh][repairs]") {
-  const auto block = sim::load_mesh(data("planning/messy/meshes/t_junction_block_mm.obj"), 1e-3);
+  const auto block = sim::load_mesh(test::data("planning/messy/meshes/t_junction_block_mm.obj"), 1e-3);
   CHECK(block->repairs.t_junctions == 2);
   CHECK(block->repairs.open_edges == 0);
   CHECK(block->triangles.size() == 16);  // the front's and back's top triangles split in two
@@ -109,7 +105,7 @@ TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split the
   CHECK(block->convex);
   CHECK(block->repairs.describe() == "2 edges split at corners that lay on them (T-junctions)");
   // An open edge with no corner on it stays open.
-  CHECK(sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3)->repairs.t_junctions == 0);
+  CHECK(sim::load_mesh(test::data("planning/messy/meshes/open_block_mm.stl"), 1e-3)->repairs.t_junctions == 0);
   // A real one: FurnitureBench's cabinet door (tests/data/real), three bodies welded into one,
   // read as 24 open edges before.
   const auto door = sim::load_mesh(std::filesystem::path(REAL_DATA_DIR) / "fb-cabinet/meshes/cabinet_door_right.obj");
@@ -118,14 +114,14 @@ TEST_CASE("T-junctions: an edge run whole past a neighbour's corner is split the
 }
 
 TEST_CASE("a hole of three edges is closed by the triangle missing there, a hole of four is not", "[mesh][repairs]") {
-  const auto block = sim::load_mesh(data("planning/messy/meshes/missing_triangle_block_mm.obj"), 1e-3);
+  const auto block = sim::load_mesh(test::data("planning/messy/meshes/missing_triangle_block_mm.obj"), 1e-3);
   CHECK(block->repairs.missing_triangles == 1);
   CHECK(block->repairs.open_edges == 0);
   CHECK(block->repairs.flipped == 0);  // filled wound as its neighbours are
   CHECK(block->convex);
   CHECK(block->repairs.describe() == "1 missing triangle filled (a hole of three edges)");
   // A hole of four edges (the open box's missing top) is left open.
-  const auto open_box = sim::load_mesh(data("planning/messy/meshes/open_block_mm.stl"), 1e-3);
+  const auto open_box = sim::load_mesh(test::data("planning/messy/meshes/open_block_mm.stl"), 1e-3);
   CHECK(open_box->repairs.missing_triangles == 0);
   CHECK(open_box->repairs.open_edges == 4);
 }
@@ -150,7 +146,7 @@ TEST_CASE("T-junctions: a file of many open corners in one plane is read in boun
 }
 
 TEST_CASE("an edge shared by more than two triangles is counted and said", "[mesh][repairs]") {
-  const auto fins = sim::load_mesh(data("planning/messy/meshes/fins_mm.obj"), 1e-3);
+  const auto fins = sim::load_mesh(test::data("planning/messy/meshes/fins_mm.obj"), 1e-3);
   CHECK(fins->triangles.size() == 3);
   CHECK(fins->repairs.non_manifold_edges == 1);
   CHECK(fins->repairs.open_edges == 6);
@@ -165,13 +161,13 @@ TEST_CASE("flipped normals: triangles wound against their neighbours, or a piece
     for (const auto& t : m.triangles) v += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6;
     return v;
   };
-  const auto flipped = sim::load_mesh(data("planning/messy/meshes/flipped_block_mm.obj"), 1e-3);
+  const auto flipped = sim::load_mesh(test::data("planning/messy/meshes/flipped_block_mm.obj"), 1e-3);
   CHECK(flipped->repairs.flipped == 2);
   CHECK(volume(*flipped) == Approx(8e-6));  // 20 mm cubed, outwards
   CHECK(flipped->convex);
   CHECK(flipped->repairs.describe() == "2 triangles turned to face outwards (their normals were flipped)");
 
-  const auto inside_out = sim::load_mesh(data("planning/messy/meshes/inside_out_block_mm.obj"), 1e-3);
+  const auto inside_out = sim::load_mesh(test::data("planning/messy/meshes/inside_out_block_mm.obj"), 1e-3);
   CHECK(inside_out->repairs.flipped == 12);
   CHECK(volume(*inside_out) == Approx(8e-6));
   CHECK(inside_out->convex);
@@ -180,7 +176,7 @@ TEST_CASE("flipped normals: triangles wound against their neighbours, or a piece
 TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores a broken entry", "[mesh][cache]") {
   const auto folder = std::filesystem::temp_directory_path() / ("mesh-cache-" + std::to_string(::getpid()));
   std::filesystem::remove_all(folder);
-  const auto file = data("planning/messy/meshes/flipped_block_mm.obj");
+  const auto file = test::data("planning/messy/meshes/flipped_block_mm.obj");
   const auto loaded = sim::load_mesh(file, 1e-3);
   const auto same = [&](const sim::TriangleMesh& m) {
     CHECK(m.vertices == loaded->vertices);
@@ -199,7 +195,7 @@ TEST_CASE("the disk cache gives back the mesh as loaded, by content, and ignores
 
   // Another scale is another entry; so is another content.
   sim::MeshCache(folder).get(file, 1.0);
-  sim::MeshCache(folder).get(data("planning/messy/meshes/inside_out_block_mm.obj"), 1e-3);
+  sim::MeshCache(folder).get(test::data("planning/messy/meshes/inside_out_block_mm.obj"), 1e-3);
   CHECK(std::distance(std::filesystem::directory_iterator(folder), {}) == 3);
 
   // A cut entry is not used: the mesh is loaded again and the entry written whole.
@@ -244,7 +240,7 @@ TEST_CASE("the cache in memory: a second ask for a mesh is the same mesh, not lo
   const auto folder = std::filesystem::temp_directory_path() / ("mesh-memory-" + std::to_string(::getpid()));
   std::filesystem::remove_all(folder);
   sim::MeshCache cache(folder);
-  const auto file = data("planning/messy/meshes/flipped_block_mm.obj");
+  const auto file = test::data("planning/messy/meshes/flipped_block_mm.obj");
   const auto first = cache.get(file, 1e-3);
   std::filesystem::remove_all(folder);  // nothing on disk: a second load would have to parse the file again
   CHECK(cache.get(file, 1e-3) == first);
@@ -258,7 +254,7 @@ TEST_CASE("COLLADA: the file's own unit is applied, its up axis is not (coordina
   // A 20 mm cube from 0 to 20 mm on each axis, <unit meter="0.001">, declared Y up and Z up.
   for (const char* file : {"planning/collada/meshes/block_mm_y_up.dae", "planning/collada/meshes/block_mm_z_up.dae"}) {
     INFO(file);
-    const auto block = sim::load_mesh(data(file));
+    const auto block = sim::load_mesh(test::data(file));
     CHECK(block->triangles.size() == 12);
     CHECK(block->bounds.min().isApprox(Eigen::Vector3d::Zero(), 1e-9));
     CHECK(block->bounds.max().isApprox(Eigen::Vector3d(0.02, 0.02, 0.02), 1e-6));
@@ -303,14 +299,14 @@ TEST_CASE("objects that are not convex pieces are joined into one piece, welded:
   // The beam of tests/data/planning/beam-frame written with every face an object of its own,
   // each with its own copies of the corners. Taken as convex pieces, each face would be a flat
   // hull, and a part could pass through the beam between them.
-  const auto mesh = sim::load_mesh(data("planning/beam-frame/meshes/beam_faces.obj"), 0.001);
+  const auto mesh = sim::load_mesh(test::data("planning/beam-frame/meshes/beam_faces.obj"), 0.001);
   CHECK(mesh->pieces.size() == 1);
   CHECK(mesh->repairs.joined_objects == 12);
   CHECK(mesh->repairs.open_edges == 0);  // welded where the faces meet: closed
   CHECK_FALSE(mesh->convex);
   CHECK(sim::loading_report(*mesh).find("12 objects that are not convex pieces joined into one") != std::string::npos);
   // An authored decomposition stays as it is.
-  const auto faceplate = sim::load_mesh(products("cranfield/meshes/faceplate.obj"), 1);
+  const auto faceplate = sim::load_mesh(test::product("cranfield/meshes/faceplate.obj"), 1);
   CHECK(faceplate->pieces.size() > 1);
   CHECK(faceplate->repairs.joined_objects == 0);
 }

@@ -15,6 +15,10 @@
 
 namespace test {
 
+// The example product and the resources of the default cell (deploy/cells/default.yaml).
+inline const std::string kLegoTower = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+inline const std::vector<std::string> kDefaultCellResources{"station-1", "arm-1", "mobile-robot-1", "buffer-1", "buffer-2"};
+
 inline std::filesystem::path scratch(const std::string& name) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("agile-cell-test-" + std::to_string(::getpid())) / name;

@@ -48,13 +48,6 @@ sim::TriangleMesh l_bracket() {
   return mesh;
 }
 
-bool has_finding(const twin::Plan& plan, const std::string& kind, const std::string& text) {
-  for (const auto& f : plan.findings) {
-    if (f.kind == kind && f.message.find(text) != std::string::npos) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 TEST_CASE("grasps: behind the push first, the narrower faces first, never ahead of the push", "[planning][grasp]") {
@@ -139,7 +132,7 @@ TEST_CASE("grasps: a part no grasp takes is reported with what the gripper hit",
   const auto loaded = twin::load_product(test::data("planning/grasp/wide-sheet.aml"), cache);
   const twin::Plan plan = plan_of(loaded);
   CHECK_FALSE(plan.complete);
-  CHECK(has_finding(plan, "infeasible", "sheet: no collision-free path; the gripper hit station on every grasp"));
+  CHECK(test::has_finding(plan, "infeasible", "sheet: no collision-free path; the gripper hit station on every grasp"));
 }
 
 TEST_CASE("grasps: a smaller gripper from the deployment file leaves a part it cannot open around", "[planning][grasp]") {
@@ -149,7 +142,7 @@ TEST_CASE("grasps: a smaller gripper from the deployment file leaves a part it c
   options.gripper.max_opening = 0.012;  // the panel (4 mm) fits, the bushing (16 mm) does not
   const twin::Plan plan = plan_of(loaded, options);
   CHECK_FALSE(plan.complete);
-  CHECK(has_finding(plan, "infeasible", "bushing: no grasp: it is 16.00 mm across at its narrowest, 4.00 mm more than the gripper opens"));
+  CHECK(test::has_finding(plan, "infeasible", "bushing: no grasp: it is 16.00 mm across at its narrowest, 4.00 mm more than the gripper opens"));
 }
 
 TEST_CASE("grasps: a finger on a face of a concave part's box may close on air, and such a grasp does not hold it",

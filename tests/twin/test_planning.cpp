@@ -33,12 +33,6 @@ std::size_t at(const std::vector<std::string>& order, const std::string& name) {
   return static_cast<std::size_t>(it - order.begin());
 }
 
-bool has_finding(const twin::Plan& plan, const std::string& kind, const std::string& fragment) {
-  return std::any_of(plan.findings.begin(), plan.findings.end(), [&](const twin::Finding& f) {
-    return f.kind == kind && f.message.find(fragment) != std::string::npos;
-  });
-}
-
 }  // namespace
 
 TEST_CASE("Cranfield: back first, shaft before pendulum, square pegs before separator, front last", "[planning][cranfield]") {
@@ -64,7 +58,7 @@ TEST_CASE("Cranfield: back first, shaft before pendulum, square pegs before sepa
         }
       }
       // The links leave the bolts' order open: the designer is told.
-      CHECK(has_finding(p, "open-order", "boltR1"));
+      CHECK(test::has_finding(p, "open-order", "boltR1"));
     }
   }
 }
@@ -90,7 +84,7 @@ TEST_CASE("Lego tower: bottom-up, and the hanging brick goes in sideways after a
       CHECK(hanging.failed.front().trajectory.label == "down");
       CHECK(hanging.failed.front().collision->with == "overhang");
       CHECK(std::abs(hanging.trajectory.direction.y()) < 1e-9);  // from the side
-      CHECK(has_finding(p, "collision", "hanging (down): part hit overhang"));
+      CHECK(test::has_finding(p, "collision", "hanging (down): part hit overhang"));
     }
   }
 }
@@ -101,13 +95,13 @@ TEST_CASE("backtracking: the paper heuristic stops where the search planner fini
   const twin::Plan paper = plan(test::data("planning/backtrack/backtrack.aml"), "paper", cache, loaded);
   CHECK_FALSE(paper.complete);
   CHECK(order(loaded, paper) == std::vector<std::string>{"base", "cap"});
-  CHECK(has_finding(paper, "infeasible", "block: no collision-free path; blocked by cap"));
+  CHECK(test::has_finding(paper, "infeasible", "block: no collision-free path; blocked by cap"));
 
   const twin::Plan search = plan(test::data("planning/backtrack/backtrack.aml"), "search", cache, loaded);
   REQUIRE(search.complete);
   CHECK(order(loaded, search) == std::vector<std::string>{"base", "block", "cap"});
   CHECK(search.backtracks == 1);
-  CHECK(has_finding(search, "backtrack", "cap"));
+  CHECK(test::has_finding(search, "backtrack", "cap"));
 }
 
 TEST_CASE("a product no order can build is reported with what blocks what", "[planning][impossible]") {
@@ -115,7 +109,7 @@ TEST_CASE("a product no order can build is reported with what blocks what", "[pl
   twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan p = plan(test::data("planning/impossible/impossible.aml"), "search", cache, loaded);
   CHECK_FALSE(p.complete);
-  CHECK(has_finding(p, "infeasible", "block: no collision-free path; blocked by shell"));
+  CHECK(test::has_finding(p, "infeasible", "block: no collision-free path; blocked by shell"));
 }
 
 TEST_CASE("the same input gives the same plan", "[planning][determinism]") {
@@ -166,7 +160,7 @@ TEST_CASE("no straight insertion: OMPL's RRT-Connect finds a path, checked in th
   twin::LoadedProduct loaded{twin::Product("", ""), {}, {}};
   const twin::Plan linear = plan(test::data("planning/ledge/ledge.aml"), "search", cache, loaded, "linear");
   CHECK_FALSE(linear.complete);
-  CHECK(has_finding(linear, "infeasible", "block: no collision-free path"));
+  CHECK(test::has_finding(linear, "infeasible", "block: no collision-free path"));
 
   const twin::Plan sampled = plan(test::data("planning/ledge/ledge.aml"), "search", cache, loaded, "ompl");
   REQUIRE(sampled.complete);
@@ -260,7 +254,7 @@ TEST_CASE("insertion margins: the room each part and its gripper have on the way
       CHECK(step.margin->with == "back");
       CHECK(step.margin->member == "part");
       CHECK(step.margin->phase == "insert");
-      CHECK(has_finding(p, "margin", "(" + std::string(peg) + "): the part passes 0.50 mm from back while insert"));
+      CHECK(test::has_finding(p, "margin", "(" + std::string(peg) + "): the part passes 0.50 mm from back while insert"));
     }
     // The back plate lies on the station: its seat does not count, only the fingers beside it.
     const auto& back = p.steps[at(o, "back")];
@@ -281,18 +275,18 @@ TEST_CASE("insertion margins: the room each part and its gripper have on the way
     CHECK(first.steps[1].margin->with == "tall");
     CHECK(first.steps[1].margin->distance == Approx(0.0005).margin(1e-5));
     CHECK_FALSE(first.steps[0].margin);  // nothing within 10 mm of the first block
-    CHECK(has_finding(first, "margin", "step 2 (short): the carriage passes 0.50 mm from tall"));
+    CHECK(test::has_finding(first, "margin", "step 2 (short): the carriage passes 0.50 mm from tall"));
 
     options.objective = twin::Objective::margin;
     const twin::Plan roomy = twin::plan_assembly(loaded, *s, *path, options);
     REQUIRE(roomy.complete);
     CHECK(order(loaded, roomy) == std::vector<std::string>{"short", "tall"});
     CHECK(twin::least_margin(roomy.steps, options.margin_reach) == Approx(0.0025).margin(1e-5));
-    CHECK_FALSE(has_finding(roomy, "margin", ""));
-    CHECK(has_finding(roomy, "margin-search", "least margin of 2.50 mm (the first order found: 0.50 mm)"));
+    CHECK_FALSE(test::has_finding(roomy, "margin", ""));
+    CHECK(test::has_finding(roomy, "margin-search", "least margin of 2.50 mm (the first order found: 0.50 mm)"));
 
     options.margin_threshold = 0;  // no step is flagged
-    CHECK_FALSE(has_finding(twin::plan_assembly(loaded, *s, *path, options), "margin", ""));
+    CHECK_FALSE(test::has_finding(twin::plan_assembly(loaded, *s, *path, options), "margin", ""));
   }
   SECTION("a one-piece concave part past the triangle limit is not measured, and the findings say so") {
     loaded = twin::load_product(test::data("planning/lipped-box/lipped-box.aml"), cache);
@@ -310,7 +304,7 @@ TEST_CASE("insertion margins: the room each part and its gripper have on the way
     const twin::Plan limited = twin::plan_assembly(loaded, *s, *path, options);
     REQUIRE(limited.complete);
     CHECK_FALSE(limited.steps[at(order(loaded, limited), "wall_left")].margin_measured);
-    CHECK(has_finding(limited, "margin", "(wall_left): margin not measured: one concave piece of " +
+    CHECK(test::has_finding(limited, "margin", "(wall_left): margin not measured: one concave piece of " +
                                             std::to_string(triangles) + " triangles"));
     // The block is one convex piece: measured whatever its size.
     CHECK(limited.steps[at(order(loaded, limited), "block")].margin_measured);
@@ -346,7 +340,7 @@ TEST_CASE("suggested precedences settle the open order: written into the product
     REQUIRE(suggestions.size() == 1);
     CHECK(loaded.product.parts()[suggestions[0].before].name == "block");
     CHECK(loaded.product.parts()[suggestions[0].after].name == "cap");
-    CHECK(has_finding(plan, "suggestion", "step 2: put block before cap: with cap there instead, no order goes together"));
+    CHECK(test::has_finding(plan, "suggestion", "step 2: put block before cap: with cap there instead, no order goes together"));
 
     const auto settled = twin::load_product(dir / "backtrack.aml", cache);  // its meshes copied beside it
     REQUIRE(settled.product.precedences().size() == 1);
@@ -367,7 +361,7 @@ TEST_CASE("suggested precedences settle the open order: written into the product
     twin::Plan plan = twin::plan_assembly(loaded, *sequence, *path, options);
     const auto suggestions = replan(loaded, plan, options, "margin.aml");
     REQUIRE(suggestions.size() == 1);
-    CHECK(has_finding(plan, "suggestion", "put short before tall: with tall there instead, the least margin is 0.50 mm (2.50 mm this way)"));
+    CHECK(test::has_finding(plan, "suggestion", "put short before tall: with tall there instead, the least margin is 0.50 mm (2.50 mm this way)"));
     const auto settled = twin::load_product(dir / "margin.aml", cache);
     const twin::Plan again = twin::plan_assembly(settled, *sequence, *path);  // not even asked for margin
     CHECK(order(settled, again) == std::vector<std::string>{"short", "tall"});

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include "sim/mesh/triangle_mesh.hpp"
+#include "tests/support/paths.hpp"
 #include "twin/geometry/product_loader.hpp"
 #include "twin/planning/assembly_planner.hpp"
 #include "twin/planning/path_planner.hpp"
@@ -14,8 +15,13 @@
 
 namespace test {
 
-inline std::filesystem::path data(const std::string& relative) { return std::filesystem::path(TEST_DATA_DIR) / relative; }
-inline std::filesystem::path product(const std::string& relative) { return std::filesystem::path(PRODUCTS_DIR) / relative; }
+// Whether the plan has a finding of this kind whose message contains the fragment.
+inline bool has_finding(const twin::Plan& plan, const std::string& kind, const std::string& fragment) {
+  for (const auto& f : plan.findings) {
+    if (f.kind == kind && f.message.find(fragment) != std::string::npos) return true;
+  }
+  return false;
+}
 
 inline twin::LoadedProduct load(const std::filesystem::path& file) {
   sim::MeshCache cache;
