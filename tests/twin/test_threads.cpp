@@ -15,20 +15,21 @@
 
 namespace {
 
-constexpr double kPitch = 0.002;    // m: M16's coarse pitch
+constexpr double kPitch = 0.002;    // m: M16's coarse pitch, and ISO's for the thread's 14 mm
+constexpr double kFine = 0.0015;    // m: a fine pitch (M14 x 1.5)
 constexpr double kRoot = 0.006;     // m: the bolt's radius at its thread's roots
 constexpr double kHeight = 0.001;   // m: its crests stand this far out
 constexpr double kOverlap = 0.0004; // m: the nut's thread reaches this far into the bolt's
 
 // 0 at a root, 1 at a crest, along a right-hand thread.
-double ridge(double t, double y) {
-  const double u = (y + kPitch * t / (2 * M_PI)) / kPitch;
+double ridge(double t, double y, double pitch = kPitch) {
+  const double u = (y + pitch * t / (2 * M_PI)) / pitch;
   return std::abs(2 * (u - std::floor(u)) - 1);
 }
 
-struct Made {
+struct PartsAtOrigin {
   twin::LoadedProduct loaded{twin::Product("made", "made.aml"), {}, {}};
-  Made& part(const std::string& name, sim::TriangleMesh mesh) {
+  PartsAtOrigin& part(const std::string& name, sim::TriangleMesh mesh) {
     twin::DigitalPart p;
     p.id = p.name = name;
     loaded.product.add_part(p);
@@ -37,20 +38,24 @@ struct Made {
   }
 };
 
+// Rings of vertices an eighth of the pitch apart along the axis.
+int levels(double length, double pitch) { return static_cast<int>(std::lround(8 * length / pitch)); }
+
 // Plain: a rod to the thread's crests.
-sim::TriangleMesh bolt(bool threaded = true) {
+sim::TriangleMesh bolt(bool threaded = true, double pitch = kPitch) {
   return test::revolved_tube(
-      48, 120, 0.0, 0.030, [threaded](double t, double y) { return kRoot + kHeight * (threaded ? ridge(t, y) : 1); },
+      48, levels(0.030, pitch), 0.0, 0.030,
+      [threaded, pitch](double t, double y) { return kRoot + kHeight * (threaded ? ridge(t, y, pitch) : 1); },
       [](double, double) { return 0.0; });
 }
 
 // Its thread `overlap` into the bolt's, from 14 to 22 mm up; plain: a ring bored to the
 // crests' radius less the overlap.
-sim::TriangleMesh nut(bool threaded) {
+sim::TriangleMesh nut(bool threaded, double pitch = kPitch) {
   return test::revolved_tube(
-      48, 32, 0.014, 0.022, [](double, double) { return 0.012; },
-      [threaded](double t, double y) {
-        return (threaded ? kRoot + kHeight * ridge(t, y) : kRoot + kHeight) - kOverlap;
+      48, levels(0.008, pitch), 0.014, 0.022, [](double, double) { return 0.012; },
+      [threaded, pitch](double t, double y) {
+        return (threaded ? kRoot + kHeight * ridge(t, y, pitch) : kRoot + kHeight) - kOverlap;
       });
 }
 
@@ -58,7 +63,7 @@ sim::TriangleMesh nut(bool threaded) {
 
 TEST_CASE("threads: a nut modelled with its thread into its bolt's is a thread round the bolt's axis, a plain ring on a plain rod is not",
           "[threads]") {
-  Made threaded;
+  PartsAtOrigin threaded;
   threaded.part("bolt", bolt()).part("nut", nut(true));
   const auto check = twin::find_interferences(threaded.loaded);
   REQUIRE(check.overlaps.size() == 1);
@@ -68,13 +73,14 @@ TEST_CASE("threads: a nut modelled with its thread into its bolt's is a thread r
   CHECK(thread->centre.x() == Approx(0).margin(2e-4));
   CHECK(thread->centre.z() == Approx(0).margin(2e-4));
   CHECK(thread->diameter == Approx(2 * (kRoot + kHeight)).margin(5e-4));
-  CHECK(thread->pitch == Approx(kPitch));
-  CHECK(thread->pitch_assumed);
+  CHECK(thread->pitch == Approx(kPitch).epsilon(0.01));
+  CHECK(thread->pitch_measured);
+  CHECK_FALSE(thread->left_hand);
   CHECK(thread->length == Approx(0.008).margin(1e-3));
   CHECK(twin::describe(threaded.loaded.product, *thread).rfind("nut in bolt: a thread of 14.", 0) == 0);
 
   // A plain ring on a plain rod overlaps as much, and has no thread.
-  Made plain;
+  PartsAtOrigin plain;
   plain.part("bolt", bolt(false)).part("nut", nut(false));
   const auto overlaps = twin::find_interferences(plain.loaded).overlaps;
   REQUIRE(overlaps.size() == 1);
@@ -83,7 +89,7 @@ TEST_CASE("threads: a nut modelled with its thread into its bolt's is a thread r
 
 TEST_CASE("threads: the nut is turned onto the bolt along the thread and verified, a helix off the axis or of the other hand is not",
           "[threads][planning]") {
-  Made m;
+  PartsAtOrigin m;
   m.part("bolt", bolt()).part("nut", nut(true));
   twin::SearchSequencePlanner sequence;
   twin::LinearPathPlanner path;
@@ -137,7 +143,7 @@ TEST_CASE("threads: the nut is turned onto the bolt along the thread and verifie
 }
 
 TEST_CASE("threads: a plain ring overlapping a plain rod is an interference, and no plan holds both", "[threads][planning]") {
-  Made m;
+  PartsAtOrigin m;
   m.part("bolt", bolt(false)).part("nut", nut(false));
   twin::SearchSequencePlanner sequence;
   twin::LinearPathPlanner path;
@@ -145,4 +151,37 @@ TEST_CASE("threads: a plain ring overlapping a plain rod is an interference, and
   CHECK_FALSE(plan.complete);
   CHECK(plan.steps.size() == 1);
   CHECK(std::none_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) { return f.kind == "thread"; }));
+}
+
+TEST_CASE("threads: a fine thread is turned at the pitch it is modelled with, measured on its surface, not at ISO's coarse one",
+          "[threads][planning]") {
+  PartsAtOrigin m;
+  m.part("bolt", bolt(true, kFine)).part("nut", nut(true, kFine));
+  const auto overlaps = twin::find_interferences(m.loaded).overlaps;
+  REQUIRE(overlaps.size() == 1);
+  const auto thread = twin::thread_of(m.loaded, overlaps.front());
+  REQUIRE(thread);
+  CHECK(thread->pitch == Approx(kFine).epsilon(0.01));
+  CHECK(thread->pitch_measured);
+  CHECK(twin::describe(m.loaded.product, *thread).find("pitch 1.50 mm (measured on the model)") != std::string::npos);
+
+  twin::SearchSequencePlanner sequence;
+  twin::LinearPathPlanner path;
+  const twin::Plan plan = twin::plan_assembly(m.loaded, sequence, path);
+  for (const auto& f : plan.findings) UNSCOPED_INFO(f.kind + ": " + f.message);
+  REQUIRE(plan.complete);
+  CHECK(plan.verification.passed);
+  REQUIRE(plan.steps[1].trajectory.screw);
+  CHECK(plan.steps[1].trajectory.screw->pitch == Approx(kFine).epsilon(0.01));
+
+  SECTION("a link that says the thread is ISO's coarse pitch, 2 mm, is refused by the replay") {
+    auto& nut_part = m.loaded.product.parts()[1];
+    nut_part.own_interfaces["thread"] = twin::Frame{};
+    nut_part.own_joints["thread"] = twin::Joint{twin::Joint::Kind::screw, kPitch, {}};
+    m.loaded.product.parts()[0].own_interfaces["thread"] = twin::Frame{};
+    m.loaded.product.connect("bolt", "thread", "nut", "thread", "bolt-nut", {});
+    const twin::Plan declared = twin::plan_assembly(m.loaded, sequence, path);
+    CHECK_FALSE(declared.complete);
+    CHECK(test::has_finding(declared, "verification", "nut"));
+  }
 }

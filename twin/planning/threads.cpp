@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 
 #include <Eigen/Eigenvalues>
 
@@ -16,6 +18,11 @@ constexpr int kSectors = 12;               // "all round": the overlap in at lea
 // m: the samples lie up to the overlap's depth from either surface; the shell they make is
 // as thick as the overlap and this much more (sampling, tessellation)
 constexpr double kShellSlack = 2e-4;
+// A thread's surface follows its helix at least this well for its pitch to be taken from it
+// (measure_pitch's coherence): a clean thread 0.75-0.8 (ours, IsaacGym's M12 bolt); a plain
+// shaft's tessellation under 0.1; FurnitureBench's coarse printed threads 0.1-0.4, at pitches
+// that differ from one line to the next by half: not clear, ISO's is taken there.
+constexpr double kClearWave = 0.5;
 
 // ISO 261 coarse series: nominal diameter and pitch, mm.
 constexpr std::array<std::pair<double, double>, 23> kCoarse{{{1, 0.25},  {1.2, 0.25}, {1.6, 0.35}, {2, 0.4},   {2.5, 0.45},
@@ -145,6 +152,98 @@ bool ridged(const std::vector<Vec3>& vertices, const Fit& fit, double pitch) {
   return *lowest > 0 && *highest - *lowest <= 0.3 * pitch + kShellSlack && most - least >= 0.3 * pitch;
 }
 
+// A thread's pitch as the part is modelled, measured on its surface near the overlap: the
+// relief of its vertices (their distance from the axis less the mean: crests one way, roots
+// the other) is a wave along the helix, cos(2π·along/p − θ) for a right-hand thread with θ
+// turning about the axis, cos(2π·along/p + θ) for a left-hand one. The pitch is the period
+// whose wave the vertices follow best: the sum of relief · e^(−i phase) over the vertices is
+// largest there. The turn in the phase makes the sum small at the pitch's multiples and
+// fractions, and for a plain shaft or bore, whose relief is only its tessellation's.
+struct MeasuredPitch {
+  double pitch = 0;      // m
+  double coherence = 0;  // |sum| / sum |relief|: about 0.8 for a clean thread, near 0 for none
+  bool left_hand = false;
+  double turns = 0;  // the thread's length measured on: the more, the sharper the pitch
+};
+
+std::optional<MeasuredPitch> measure_pitch(const std::vector<Vec3>& vertices, const Fit& fit, double guess) {
+  constexpr double kFinest = 2e-4, kCoarsest = 0.01;  // m: the pitches looked for
+  const double finest = std::max(kFinest, guess / 4), coarsest = std::min(kCoarsest, guess * 4);
+  // The thread beyond the overlap, too: the more turns, the sharper the pitch.
+  const double low = fit.low - 10 * guess, high = fit.high + 10 * guess;
+  const Vec3 u = fit.line.axis.unitOrthogonal(), v = fit.line.axis.cross(u);
+  struct Sample {
+    double along, turn, relief;
+  };
+  std::vector<Sample> samples;
+  double mean = 0;
+  for (const Vec3& p : vertices) {
+    const Vec3 d = p - fit.line.point;
+    const double along = d.dot(fit.line.axis);
+    if (along < low || along > high) continue;
+    const double x = d.dot(u), y = d.dot(v), r = std::hypot(x, y);
+    if (r < fit.outer - 1.5 * guess || r > fit.outer + guess) continue;
+    samples.push_back({along, std::atan2(y, x), r});
+    mean += r;
+  }
+  if (samples.size() < 8 * kFewestPoints) return std::nullopt;
+  mean /= static_cast<double>(samples.size());
+  double total = 0;
+  for (auto& s : samples) {
+    s.relief -= mean;
+    total += std::abs(s.relief);
+  }
+  if (total <= 0) return std::nullopt;
+  // The vertices in thin slices along the axis, each slice's relief summed with its turn
+  // (either hand). What does not change along the axis (the surface's centre a little off
+  // the line: relief with one turn) is taken out, or its wide peak at no pitch pulls the
+  // thread's.
+  const double slice = finest / 32;
+  const auto slices = static_cast<std::size_t>(std::ceil((high - low) / slice)) + 1;
+  std::array<std::vector<std::complex<double>>, 2> sliced;
+  std::vector<double> count(slices, 0);
+  for (auto& hand : sliced) hand.assign(slices, 0.0);
+  for (const auto& s : samples) {
+    const auto k = static_cast<std::size_t>((s.along - low) / slice);
+    sliced[0][k] += s.relief * std::polar(1.0, s.turn);   // right hand: phase 2π·along/p − θ
+    sliced[1][k] += s.relief * std::polar(1.0, -s.turn);  // left hand
+    count[k] += 1;
+  }
+  for (auto& hand : sliced) {
+    const std::complex<double> steady = std::accumulate(hand.begin(), hand.end(), std::complex<double>(0)) /
+                                        static_cast<double>(samples.size());
+    for (std::size_t k = 0; k < slices; ++k) hand[k] -= steady * count[k];
+  }
+  const double tau = 2 * static_cast<double>(EIGEN_PI);
+  const auto strength = [&](std::size_t hand, double frequency) {
+    std::complex<double> sum = 0;
+    for (std::size_t k = 0; k < slices; ++k) {
+      if (count[k] > 0) sum += sliced[hand][k] * std::polar(1.0, -tau * frequency * (k + 0.5) * slice);
+    }
+    return std::abs(sum) / total;
+  };
+  // Frequencies (1/p) a twentieth of a turn over the span apart, then a hundredth of that
+  // about the best.
+  MeasuredPitch best;
+  double best_frequency = 0;
+  const double step = 0.05 / (high - low);
+  for (std::size_t hand = 0; hand < 2; ++hand) {
+    for (double f = 1 / coarsest; f <= 1 / finest; f += step) {
+      const double c = strength(hand, f);
+      if (c > best.coherence) best = {1 / f, c, hand == 1}, best_frequency = f;
+    }
+  }
+  const std::size_t hand = best.left_hand ? 1 : 0;
+  for (double f = best_frequency - step; f <= best_frequency + step; f += step / 100) {
+    const double c = strength(hand, f);
+    if (c > best.coherence) best = {1 / f, c, best.left_hand};
+  }
+  const auto [first, last] = std::minmax_element(samples.begin(), samples.end(),
+                                                 [](const Sample& a, const Sample& b) { return a.along < b.along; });
+  best.turns = (last->along - first->along) / best.pitch;
+  return best;
+}
+
 // How long the two parts' threads engage: where both have surface within a pitch of the
 // overlap's radius, along the axis.
 double engaged_length(const std::array<std::vector<Vec3>, 2>& vertices, const Fit& fit, double pitch) {
@@ -197,15 +296,26 @@ std::optional<Thread> thread_of(const LoadedProduct& product, const Interference
     const double shell = fit.outer - fit.inner;
     if (shell >= thinnest) continue;
     const double diameter = 2 * fit.outer;
-    const double pitch = declared ? declared->pitch : coarse_pitch(diameter);
+    const double guess = declared ? declared->pitch : coarse_pitch(diameter);
     // The samples lie anywhere between the threads' roots and crests (a thread's height, 0.54
     // of the pitch), and up to the overlap's depth from the nearer surface past them, which
     // on a flank (60 degrees) is twice as deep across the axis.
-    if (shell > 0.6 * pitch + 2 * interference.depth + kShellSlack) continue;
+    if (shell > 0.6 * guess + 2 * interference.depth + kShellSlack) continue;
     // Out of phase, ISO's basic profiles overlap by at most 5/8 of the triangle's height,
     // 0.54 of the pitch.
-    if (interference.depth > 0.6 * pitch + kShellSlack) continue;
-    if (!declared && !ridged(vertices[0], fit, pitch) && !ridged(vertices[1], fit, pitch)) continue;
+    if (interference.depth > 0.6 * guess + kShellSlack) continue;
+    if (!declared && !ridged(vertices[0], fit, guess) && !ridged(vertices[1], fit, guess)) continue;
+    // Undeclared, the pitch the parts are modelled with where either's surface shows it
+    // clearly (on the longer thread of the two, a bolt's rather than its nut's), else ISO's.
+    std::optional<MeasuredPitch> measured;
+    if (!declared) {
+      for (const auto& part : vertices) {
+        const auto m = measure_pitch(part, fit, guess);
+        if (m && m->coherence >= kClearWave && (!measured || m->turns > measured->turns)) measured = m;
+      }
+    }
+    const double pitch = measured ? measured->pitch : guess;
+    if (measured && interference.depth > 0.6 * pitch + kShellSlack) continue;
     Thread t;
     t.part1 = interference.part1;
     t.part2 = interference.part2;
@@ -216,7 +326,9 @@ std::optional<Thread> thread_of(const LoadedProduct& product, const Interference
     t.length = engaged_length(vertices, fit, pitch);
     t.pitch = pitch;
     t.declared = declared != nullptr;
-    t.pitch_assumed = !declared;
+    t.pitch_measured = measured.has_value();
+    t.left_hand = measured && measured->left_hand;
+    t.pitch_assumed = !declared && !measured;
     best = t;
     thinnest = shell;
   }
@@ -227,7 +339,10 @@ std::string describe(const Product& product, const Thread& t) {
   char text[200];
   std::snprintf(text, sizeof text, "a thread of %.1f mm, %.2f mm overlap, %.1f mm engaged, pitch %.2f mm%s", t.diameter * 1000,
                 t.depth * 1000, t.length * 1000, t.pitch * 1000,
-                t.pitch_assumed ? " (ISO coarse for the diameter)" : t.declared ? " (as its link declares)" : "");
+                t.pitch_assumed    ? " (ISO coarse for the diameter)"
+                : t.declared       ? " (as its link declares)"
+                : t.left_hand      ? " (measured on the model, left-hand)"
+                                   : " (measured on the model)");
   return product.parts()[t.part2].name + " in " + product.parts()[t.part1].name + ": " + text;
 }
 

@@ -8,7 +8,9 @@
 // A pair is a thread where its overlap (interference.hpp's samples of either surface inside the
 // other) lies in a thin shell all round one axis, no thicker than a thread's depth for its
 // diameter; or where a link between the two declares a screw (docs/automationml.md, "Joints"),
-// whose pitch it gives. Otherwise the pitch is ISO 261's coarse pitch for the diameter.
+// whose pitch it gives. Otherwise the pitch is the one the parts are modelled with, measured on
+// their surfaces (the helix their crests and roots follow), or, where neither shows a helix
+// clearly (a thread modelled at its nominal diameter), ISO 261's coarse pitch for the diameter.
 
 #include <optional>
 #include <string>
@@ -27,6 +29,8 @@ struct Thread {
   double length = 0;               // m engaged along the axis
   double pitch = 0;                // m the part advances per turn
   bool declared = false;           // a link declares the screw (and its pitch)
+  bool pitch_measured = false;     // the helix the parts' surfaces follow (threads.cpp)
+  bool left_hand = false;          // measured so; the plan turns right-hand threads only
   bool pitch_assumed = false;      // ISO coarse for the diameter
 
   PartIndex other(PartIndex part) const { return part == part1 ? part2 : part1; }
