@@ -285,7 +285,7 @@ TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm opera
   const json& screw = (*nut)["screw"];
   REQUIRE(screw.is_object());
   CHECK(screw["into"] == "bolt");
-  CHECK(screw["pitch"].get<double>() == Approx(0.00175));
+  CHECK(screw["pitch"].get<double>() == Approx(0.00175).epsilon(0.005));  // M12's, measured on the model
   CHECK(turning == Approx(2 * M_PI * screw["turns"].get<double>()).epsilon(0.05));
 }
 

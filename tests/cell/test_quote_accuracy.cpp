@@ -95,7 +95,7 @@ TEST_CASE("quotes come true: on generated cells each quote is near its physical 
     std::mt19937 random(7919 * (pair + 1));
     const fs::path dir = test::scratch("quote-accuracy-" + std::to_string(pair));
     const std::vector<std::string> names{"a", "b"};
-    const std::vector<int> domains{214, 215};
+    const std::vector<int> domains{217, 222};  // no other test's: a cell-sim of another test answered an arm here once
     std::vector<fs::path> files;
     for (std::size_t c = 0; c < 2; ++c) {
       files.push_back(dir / (names[c] + ".yaml"));

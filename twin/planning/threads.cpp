@@ -18,11 +18,10 @@ constexpr int kSectors = 12;               // "all round": the overlap in at lea
 // m: the samples lie up to the overlap's depth from either surface; the shell they make is
 // as thick as the overlap and this much more (sampling, tessellation)
 constexpr double kShellSlack = 2e-4;
-// A thread's surface follows its helix at least this well for its pitch to be taken from it
-// (measure_pitch's coherence): a clean thread 0.75-0.8 (ours, IsaacGym's M12 bolt); a plain
-// shaft's tessellation under 0.1; FurnitureBench's coarse printed threads 0.1-0.4, at pitches
-// that differ from one line to the next by half: not clear, ISO's is taken there.
-constexpr double kClearWave = 0.5;
+// A thread's crests or roots follow their helix at least this well for its pitch to be taken
+// from them (measure_pitch's coherence; docs/performance.md has the figures of ours and the
+// real set's).
+constexpr double kClearWave = 0.7;
 
 // ISO 261 coarse series: nominal diameter and pitch, mm.
 constexpr std::array<std::pair<double, double>, 23> kCoarse{{{1, 0.25},  {1.2, 0.25}, {1.6, 0.35}, {2, 0.4},   {2.5, 0.45},
@@ -152,66 +151,44 @@ bool ridged(const std::vector<Vec3>& vertices, const Fit& fit, double pitch) {
   return *lowest > 0 && *highest - *lowest <= 0.3 * pitch + kShellSlack && most - least >= 0.3 * pitch;
 }
 
-// A thread's pitch as the part is modelled, measured on its surface near the overlap: the
-// relief of its vertices (their distance from the axis less the mean: crests one way, roots
-// the other) is a wave along the helix, cos(2π·along/p − θ) for a right-hand thread with θ
-// turning about the axis, cos(2π·along/p + θ) for a left-hand one. The pitch is the period
-// whose wave the vertices follow best: the sum of relief · e^(−i phase) over the vertices is
-// largest there. The turn in the phase makes the sum small at the pitch's multiples and
-// fractions, and for a plain shaft or bore, whose relief is only its tessellation's.
+// A thread's pitch as the part is modelled, measured on its surface near the overlap. Its
+// crests (the vertices farthest from the axis, for a shaft; nearest, for a bore) and its roots
+// (the other way) each lie on a helix: along = p·θ/2π + c for a right-hand thread with θ
+// turning about the axis, −p·θ/2π + c for a left-hand one. The pitch is the one whose phase,
+// 2π·along/p ∓ θ, those vertices share best: |sum of e^(i phase)| over them is largest there.
+// The turn in the phase makes the sum small at the pitch's multiples and fractions, and for a
+// ring (a plain shaft's edge). All the surface's vertices weighted by their relief are not as
+// good: their flanks' vertices, unevenly many, pull the pitch (FurnitureBench's printed legs,
+// 9.41 mm: 8.6-8.7 so, at a coherence of 0.3; 9.41 by their crests, at 0.98).
 struct MeasuredPitch {
   double pitch = 0;      // m
-  double coherence = 0;  // |sum| / sum |relief|: about 0.8 for a clean thread, near 0 for none
+  double coherence = 0;  // |sum| / count: near 1 for a clean thread, near 0 for none
   bool left_hand = false;
   double turns = 0;  // the thread's length measured on: the more, the sharper the pitch
+  Vec3 point = Vec3::Zero();  // on the thread's axis: the centre of the circle its crests (or roots) lie on
 };
 
-std::optional<MeasuredPitch> measure_pitch(const std::vector<Vec3>& vertices, const Fit& fit, double guess) {
-  constexpr double kFinest = 2e-4, kCoarsest = 0.01;  // m: the pitches looked for
-  const double finest = std::max(kFinest, guess / 4), coarsest = std::min(kCoarsest, guess * 4);
-  // The thread beyond the overlap, too: the more turns, the sharper the pitch.
-  const double low = fit.low - 10 * guess, high = fit.high + 10 * guess;
-  const Vec3 u = fit.line.axis.unitOrthogonal(), v = fit.line.axis.cross(u);
-  struct Sample {
-    double along, turn, relief;
-  };
-  std::vector<Sample> samples;
-  double mean = 0;
-  for (const Vec3& p : vertices) {
-    const Vec3 d = p - fit.line.point;
-    const double along = d.dot(fit.line.axis);
-    if (along < low || along > high) continue;
-    const double x = d.dot(u), y = d.dot(v), r = std::hypot(x, y);
-    if (r < fit.outer - 1.5 * guess || r > fit.outer + guess) continue;
-    samples.push_back({along, std::atan2(y, x), r});
-    mean += r;
-  }
-  if (samples.size() < 8 * kFewestPoints) return std::nullopt;
-  mean /= static_cast<double>(samples.size());
-  double total = 0;
-  for (auto& s : samples) {
-    s.relief -= mean;
-    total += std::abs(s.relief);
-  }
-  if (total <= 0) return std::nullopt;
-  // The vertices in thin slices along the axis, each slice's relief summed with its turn
-  // (either hand). What does not change along the axis (the surface's centre a little off
-  // the line: relief with one turn) is taken out, or its wide peak at no pitch pulls the
-  // thread's.
+// The best pitch for points (along the axis, turn about it), either hand, from `finest` to
+// `coarsest`, over a span of the axis from `low` to `high`.
+MeasuredPitch sharpest_helix(const std::vector<std::pair<double, double>>& points, double low, double high, double finest,
+                             double coarsest) {
+  // The points in thin slices along the axis, each slice's e^(∓iθ) summed (either hand);
+  // what does not change along the axis (a line through the points a little off their
+  // centre) taken out, or its wide peak at no pitch pulls the thread's.
   const double slice = finest / 32;
   const auto slices = static_cast<std::size_t>(std::ceil((high - low) / slice)) + 1;
   std::array<std::vector<std::complex<double>>, 2> sliced;
   std::vector<double> count(slices, 0);
   for (auto& hand : sliced) hand.assign(slices, 0.0);
-  for (const auto& s : samples) {
-    const auto k = static_cast<std::size_t>((s.along - low) / slice);
-    sliced[0][k] += s.relief * std::polar(1.0, s.turn);   // right hand: phase 2π·along/p − θ
-    sliced[1][k] += s.relief * std::polar(1.0, -s.turn);  // left hand
+  for (const auto& [along, turn] : points) {
+    const auto k = std::min(slices - 1, static_cast<std::size_t>(std::max(0.0, (along - low) / slice)));
+    sliced[0][k] += std::polar(1.0, turn);   // right hand: phase 2π·along/p − θ
+    sliced[1][k] += std::polar(1.0, -turn);  // left hand
     count[k] += 1;
   }
+  const auto n = static_cast<double>(points.size());
   for (auto& hand : sliced) {
-    const std::complex<double> steady = std::accumulate(hand.begin(), hand.end(), std::complex<double>(0)) /
-                                        static_cast<double>(samples.size());
+    const std::complex<double> steady = std::accumulate(hand.begin(), hand.end(), std::complex<double>(0)) / n;
     for (std::size_t k = 0; k < slices; ++k) hand[k] -= steady * count[k];
   }
   const double tau = 2 * static_cast<double>(EIGEN_PI);
@@ -220,7 +197,7 @@ std::optional<MeasuredPitch> measure_pitch(const std::vector<Vec3>& vertices, co
     for (std::size_t k = 0; k < slices; ++k) {
       if (count[k] > 0) sum += sliced[hand][k] * std::polar(1.0, -tau * frequency * (k + 0.5) * slice);
     }
-    return std::abs(sum) / total;
+    return std::abs(sum) / n;
   };
   // Frequencies (1/p) a twentieth of a turn over the span apart, then a hundredth of that
   // about the best.
@@ -238,9 +215,60 @@ std::optional<MeasuredPitch> measure_pitch(const std::vector<Vec3>& vertices, co
     const double c = strength(hand, f);
     if (c > best.coherence) best = {1 / f, c, best.left_hand};
   }
-  const auto [first, last] = std::minmax_element(samples.begin(), samples.end(),
-                                                 [](const Sample& a, const Sample& b) { return a.along < b.along; });
-  best.turns = (last->along - first->along) / best.pitch;
+  const auto [first, last] = std::minmax_element(points.begin(), points.end());
+  best.turns = (last->first - first->first) / best.pitch;
+  return best;
+}
+
+std::optional<MeasuredPitch> measure_pitch(const std::vector<Vec3>& vertices, const Fit& fit, double guess) {
+  constexpr double kFinest = 2e-4, kCoarsest = 0.012;  // m: the pitches looked for
+  const double finest = std::max(kFinest, guess / 4), coarsest = std::min(kCoarsest, guess * 4);
+  // The thread beyond the overlap, too: the more turns, the sharper the pitch.
+  const double low = fit.low - 10 * guess, high = fit.high + 10 * guess;
+  const Vec3 u = fit.line.axis.unitOrthogonal(), v = fit.line.axis.cross(u);
+  std::vector<Vec3> samples;  // the vertices of the thread's band of radii
+  for (const Vec3& p : vertices) {
+    const Vec3 d = p - fit.line.point;
+    const double along = d.dot(fit.line.axis);
+    if (along < low || along > high) continue;
+    const double r = (d - along * fit.line.axis).norm();
+    if (r < fit.outer - 1.5 * guess || r > fit.outer + guess) continue;
+    samples.push_back(p);
+  }
+  if (samples.size() < 8 * kFewestPoints) return std::nullopt;
+  std::optional<MeasuredPitch> best;
+  for (const bool outside : {true, false}) {
+    // The crests (or roots) are the vertices within a thin shell at the extreme radius: found
+    // about the overlap's line, which may be off the thread's by a part of a millimetre, then
+    // again, thinner, about the circle those lie on (flanks' vertices in the shell pull the
+    // pitch: FurnitureBench's legs, 9.67 mm in a shell of 0.7 mm, 9.41 in one of 0.1).
+    Line axis = fit.line;
+    std::vector<Vec3> edge;
+    for (const double share : {0.15, 0.03}) {
+      std::vector<double> radii;
+      for (const Vec3& s : samples) {
+        const Vec3 d = s - axis.point;
+        radii.push_back((d - d.dot(axis.axis) * axis.axis).norm());
+      }
+      const auto [least, most] = std::minmax_element(radii.begin(), radii.end());
+      const double band = share * (*most - *least);
+      edge.clear();
+      for (std::size_t k = 0; k < samples.size(); ++k) {
+        if ((outside ? *most - radii[k] : radii[k] - *least) <= band) edge.push_back(samples[k]);
+      }
+      if (edge.size() < kFewestPoints) break;
+      axis = fitted_line(edge, fit.line.axis);
+    }
+    if (edge.size() < kFewestPoints) continue;
+    std::vector<std::pair<double, double>> helix;
+    for (const Vec3& p : edge) {
+      const Vec3 d = p - axis.point;
+      helix.emplace_back(d.dot(axis.axis) + (axis.point - fit.line.point).dot(axis.axis), std::atan2(d.dot(v), d.dot(u)));
+    }
+    MeasuredPitch m = sharpest_helix(helix, low, high, finest, coarsest);
+    m.point = axis.point;
+    if (!best || m.coherence > best->coherence) best = m;
+  }
   return best;
 }
 
@@ -320,7 +348,8 @@ std::optional<Thread> thread_of(const LoadedProduct& product, const Interference
     t.part1 = interference.part1;
     t.part2 = interference.part2;
     t.axis = line.axis;
-    t.centre = line.point + line.axis * ((fit.low + fit.high) / 2);
+    const Vec3 through = measured ? measured->point : line.point;  // a point on the thread's axis
+    t.centre = through + line.axis * ((fit.low + fit.high) / 2 - (through - line.point).dot(line.axis));
     t.diameter = diameter;
     t.depth = interference.depth;
     t.length = engaged_length(vertices, fit, pitch);
