@@ -19,11 +19,14 @@
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/domains.hpp"
 #include "tests/support/hire.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
-constexpr int kDomain = 181;
+constexpr int kDomain = domains::kBufferProcess;
 
 // What the test's readers saw, guarded for the listener threads: the test thread reads
 // copies, since a listener may add (and reallocate) while it checks.
@@ -160,7 +163,7 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
 }
 
 TEST_CASE("buffer process killed hard: its capability goes when the liveliness lease runs out", "[process][buffer]") {
-  constexpr int domain = 182;
+  constexpr int domain = domains::kBufferKilled;
   test::clean_stale_dds_segments();
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-2", "--domain", std::to_string(domain), "--stock",
                              "RoundPeg=3", "--lease", "0.5"});
@@ -181,7 +184,7 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
 
 TEST_CASE("a buffer that restarts answers the command its process had taken on ABORTED, saying it restarted",
           "[process][buffer][state]") {
-  constexpr int domain = 183;
+  constexpr int domain = domains::kBufferRestarts;
   test::clean_stale_dds_segments();
   const auto dir = std::filesystem::temp_directory_path() / ("restarted-buffer-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
@@ -224,7 +227,7 @@ TEST_CASE("a cell process whose starter ended before it could ask to end with it
   const auto log = std::filesystem::temp_directory_path() / ("started-by-" + std::to_string(::getpid()) + ".log");
   const auto start = [&](pid_t starter) {  // through env(1), which runs the buffer in its own process
     return test::ChildProcess({"/usr/bin/env", "AGILE_CELL_STARTED_BY=" + std::to_string(starter), BUFFER_EXE, "--id",
-                               "buffer-1", "--domain", "184"},
+                               "buffer-1", "--domain", domains::text(domains::kOrphanedProcess)},
                               log.string());
   };
   {  // Started by this test, which runs: it stays.

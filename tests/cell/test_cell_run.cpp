@@ -21,6 +21,9 @@
 
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -207,7 +210,7 @@ std::map<std::string, json> run_product(const std::string& product, int domain, 
 TEST_CASE("cell run: the Lego tower, with a collision in virtual assembly answered by another path",
           "[process][cell][timing]") {
   const fs::path dir = scratch("lego");
-  const auto plans = run_product(std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", 186, dir);
+  const auto plans = run_product(std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", domains::kLegoTower, dir);
   const json& plan = plans.at("order-1");
   const auto events = read_events(dir / "events.jsonl");
   check_event_log(events, plans);
@@ -238,7 +241,7 @@ TEST_CASE("cell run: the Lego tower, with a collision in virtual assembly answer
 
 TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "[process][cell][timing]") {
   const fs::path dir = scratch("cranfield");
-  const auto plans = run_product(std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", 187, dir);
+  const auto plans = run_product(std::string(PRODUCTS_DIR) + "/cranfield/cranfield.aml", domains::kCranfield, dir);
   CHECK(plans.at("order-1")["complete"] == true);
   check_event_log(read_events(dir / "events.jsonl"), plans);
   CHECK(fs::file_size(dir / "out" / "animation.gltf") > 1000);
@@ -263,7 +266,8 @@ TEST_CASE("cell run: the Cranfield benchmark, virtual then physical assembly", "
 TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm operation of its own", "[.screw][process][cell]") {
   const fs::path dir = scratch("screw");
   const int code =
-      run_one_order(dir, "{bolt: 2, nut: 2}", std::string(REAL_DATA_DIR) + "/factory-nut-bolt-m12/factory-nut-bolt-m12.aml", "203");
+      run_one_order(dir, "{bolt: 2, nut: 2}", std::string(REAL_DATA_DIR) + "/factory-nut-bolt-m12/factory-nut-bolt-m12.aml",
+                    domains::text(domains::kNutOnBolt));
   INFO(read_text(dir / "cellctl.log"));
   REQUIRE(code == 0);
   const json plan = json::parse(read_text(dir / "out" / "plan.json"));
@@ -292,7 +296,8 @@ TEST_CASE("cell run: a real nut is screwed onto its bolt, the screw an arm opera
 TEST_CASE("cell run: a table whose pin goes in from below is built upside down and delivered so", "[process][cell]") {
   const fs::path dir = scratch("upside-down");
   const int code = run_one_order(dir, "{Plate: 1, Leg: 4, Pin: 1}",
-                                 std::string(TEST_DATA_DIR) + "/planning/upside-down/table-with-pin.aml", "204");
+                                 std::string(TEST_DATA_DIR) + "/planning/upside-down/table-with-pin.aml",
+                                 domains::text(domains::kUpsideDownTable));
   INFO(read_text(dir / "cellctl.log"));
   REQUIRE(code == 0);
   const json plan = json::parse(read_text(dir / "out" / "plan.json"));
@@ -325,7 +330,8 @@ TEST_CASE("cell run: a table with four threaded legs is built upside down, each 
           "[process][cell]") {
   const fs::path dir = scratch("threaded-table");
   const int code = run_one_order(dir, "{Top: 1, Leg: 4}",
-                                 std::string(TEST_DATA_DIR) + "/planning/threaded-table/threaded-table.aml", "185");
+                                 std::string(TEST_DATA_DIR) + "/planning/threaded-table/threaded-table.aml",
+                                 domains::text(domains::kThreadedTable));
   INFO(read_text(dir / "cellctl.log"));
   REQUIRE(code == 0);
   const json plan = json::parse(read_text(dir / "out" / "plan.json"));
@@ -357,7 +363,8 @@ TEST_CASE("cell run: a table with four threaded legs is built upside down, each 
 TEST_CASE("cell run: a real box whose back board is held beside its centre is assembled", "[.off-centre][process][cell]") {
   const fs::path dir = scratch("off-centre");
   const int code = run_one_order(dir, "{part0: 1, part1: 1, part2: 1, part3: 1, part4: 1}",
-                                 std::string(REAL_DATA_DIR) + "/ikea-box_ivar_0666/ikea-box_ivar_0666.aml", "177");
+                                 std::string(REAL_DATA_DIR) + "/ikea-box_ivar_0666/ikea-box_ivar_0666.aml",
+                                 domains::text(domains::kRealBoxOffCentre));
   INFO(read_text(dir / "cellctl.log"));
   REQUIRE(code == 0);
   const json plan = json::parse(read_text(dir / "out" / "plan.json"));
@@ -376,7 +383,7 @@ TEST_CASE("cell run: a real box whose back board is held beside its centre is as
 TEST_CASE("cell up: a bad order fails alone, one with a subassembly is built, the cell stays idle and usable, down ends it", "[process][cell]") {
   test::clean_stale_dds_segments();
   const fs::path dir = scratch("bad-order");
-  const std::string domain = "188";
+  const std::string domain = domains::text(domains::kBadOrderFailsAlone);
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
                         (dir / "up.log").string());
 
@@ -452,8 +459,8 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
   const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
 
   SECTION("nothing comes: the twin gives up with a clear message") {
-    test::ChildProcess twin({TWIN_EXE, "--domain", "189", "--order", "alone", "--product", product, "--out",
-                             (dir / "alone").string(), "--wait", "2"},
+    test::ChildProcess twin({TWIN_EXE, "--domain", domains::text(domains::kTwinAlone), "--order", "alone", "--product", product,
+                             "--out",                             (dir / "alone").string(), "--wait", "2"},
                             (dir / "alone.log").string());
     CHECK(twin.wait_for_exit(30s) == 1);
     const std::string log = read_text(dir / "alone.log");
@@ -461,11 +468,12 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
     CHECK(log.find("did not appear within 2 s") != std::string::npos);
   }
   SECTION("the cell comes later: the twin goes on and assembles") {
-    test::ChildProcess twin({TWIN_EXE, "--domain", "190", "--order", "early", "--product", product, "--out",
-                             (dir / "early").string(), "--wait", "60"},
+    test::ChildProcess twin({TWIN_EXE, "--domain", domains::text(domains::kTwinBeforeTheCell), "--order", "early", "--product",
+                             product, "--out",                             (dir / "early").string(), "--wait", "60"},
                             (dir / "early.log").string());
     std::this_thread::sleep_for(1s);
-    test::ChildProcess up({CELLCTL_EXE, "up", "--domain", "190", "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
+    test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domains::text(domains::kTwinBeforeTheCell), "--real-time-factor", "50",
+                           "--state-dir", (dir / "state").string()},
                           (dir / "up.log").string());
     const int code = twin.wait_for_exit(90s);
     INFO(read_text(dir / "early.log") << read_text(dir / "up.log"));
@@ -477,9 +485,11 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
 TEST_CASE("a standby twin: it reads its order from its input, and refuses a bad one", "[process][cell]") {
   const fs::path dir = scratch("standby-twin");
   const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
-  // `input` fed to a standby twin on domain 189 (no cell there); its exit code, its output in `log`.
+  // `input` fed to a standby twin on a domain with no cell; its exit code, its output in `log`.
   const auto standby = [&](const std::string& input, const fs::path& log, const std::string& more = "") {
-    test::ChildProcess twin({"/bin/sh", "-c", "{ " + input + "; } | " + TWIN_EXE + " --domain 189 --standby " + more},
+    test::ChildProcess twin({"/bin/sh", "-c",
+                             "{ " + input + "; } | " + TWIN_EXE + " --domain " + domains::text(domains::kStandbyTwin) +
+                                 " --standby " + more},
                             log.string());
     return twin.wait_for_exit(30s);
   };
@@ -512,7 +522,7 @@ TEST_CASE("a standby twin: it reads its order from its input, and refuses a bad 
 TEST_CASE("a resource that dies during an order: the twin fails it with the reason", "[process][cell]") {
   test::clean_stale_dds_segments();
   const fs::path dir = scratch("robot-dies");
-  const std::string domain = "191", bin = fs::path(TWIN_EXE).parent_path().string();
+  const std::string domain = domains::text(domains::kResourceDies), bin = fs::path(TWIN_EXE).parent_path().string();
   test::ChildProcess sim({bin + "/cell-sim", "--domain", domain, "--real-time-factor", "20"}, (dir / "sim.log").string());
   // Its dock beside its table, as in the deployment files (the default, its own place, is
   // where the product stands: virtual assembly finds the parts put down there in the way).
@@ -545,7 +555,7 @@ TEST_CASE("a twin that dies mid-order: its reservations lapse, its parts leave c
           "[process][cell]") {
   test::clean_stale_dds_segments();
   const fs::path dir = scratch("twin-dies");
-  const std::string domain = "192";
+  const std::string domain = domains::text(domains::kTwinDies);
   const std::string product = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "20", "--state-dir", (dir / "state").string()},
                         (dir / "up.log").string());
@@ -577,7 +587,8 @@ TEST_CASE("cell run: a twin frozen during physical assembly falls silent: run en
   const fs::path dir = scratch("run-twin-frozen");
   std::ofstream(dir / "cell.yaml") << read_text(kCell) << "\ntwin_watchdog: 5\n";
   test::ChildProcess run({CELLCTL_EXE, "run", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--cell",
-                          (dir / "cell.yaml").string(), "--domain", "179", "--real-time-factor", "10", "--out",
+                          (dir / "cell.yaml").string(), "--domain", domains::text(domains::kRunTwinFrozen), "--real-time-factor",
+                          "10", "--out",
                           (dir / "out").string()},
                          (dir / "run.log").string());
   REQUIRE(test::appears(dir / "run.log", "order lego-tower: twin pid "));
@@ -637,7 +648,7 @@ TEST_CASE("many orders: ten mixed orders at once on two stations and two robots"
   const fs::path dir = scratch("ten-two-stations");
   const std::string cell = std::string(DEPLOY_CELLS) + "/two-stations.yaml";
   std::string log;
-  const auto plans = run_mixed(cell, 193, dir, log);
+  const auto plans = run_mixed(cell, domains::kTenMixedOrders, dir, log);
   const auto events = read_events(dir / "events.jsonl");
   check_event_log(events, plans, cell);
   // Both stations and both robots worked; every order was assembled.
@@ -660,7 +671,7 @@ TEST_CASE("many orders: sixty at once on four stations, through the discovery se
   const fs::path dir = scratch("sixty-four-stations");
   const std::string cell = std::string(DEPLOY_CELLS) + "/four-stations.yaml";
   std::string log;
-  const auto plans = run_mixed(cell, 229, dir, log, 60, 600s);
+  const auto plans = run_mixed(cell, domains::kSixtyOrders, dir, log, 60, 600s);
   CHECK(plans.size() == 60);
   check_event_log(read_events(dir / "events.jsonl"), plans, cell);
   const std::regex assembled(R"(\n\S+\s+\S+\.aml\s+assembled\s)");
@@ -675,7 +686,7 @@ TEST_CASE("many orders: ten orders on the one-station cell queue, say so, and ar
           "[process][cell][timing][many]") {
   const fs::path dir = scratch("ten-one-station");
   std::string log;
-  const auto plans = run_mixed(kCell, 194, dir, log);
+  const auto plans = run_mixed(kCell, domains::kTenQueuedOrders, dir, log);
   check_event_log(read_events(dir / "events.jsonl"), plans);
   // Orders waited in the station's queue and said how many were ahead of them.
   int most_ahead = 0;

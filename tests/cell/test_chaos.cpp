@@ -6,13 +6,16 @@
 #include <catch2/catch.hpp>
 
 #include "tests/support/chaos.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 TEST_CASE("chaos: kills of any process lose no part, leave no hold and no process, and every order ends with a reason",
           "[process][cell][state][chaos]") {
   test::ChaosOptions o;
   o.dir = test::scratch("chaos");
   o.cell = std::string(DEPLOY_CELLS) + "/two-stations.yaml";
-  o.domain = 196;
+  o.domain = domains::kChaos;
   o.orders = 4;
   o.kills = 6;
   o.first_victims = {"twin", "cell-sim"};  // besides the random picks and cellctl up

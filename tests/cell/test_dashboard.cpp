@@ -22,6 +22,9 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -95,7 +98,7 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
           "[process][cell][dashboard]") {
   using namespace std::chrono_literals;
   const auto dir = test::scratch("dashboard");
-  const std::string domain = "175";
+  const std::string domain = domains::text(domains::kDashboard);
   const DashboardCell cell = start_dashboard_cell(dir, domain);
   const int port = cell.port;
   const std::string& token = cell.token;
@@ -146,7 +149,7 @@ TEST_CASE("the dashboard: nothing without the token, a bounded crowd of pages, a
     for (const std::string& id : test::kDefaultCellResources) {
       CHECK(std::find(ids.begin(), ids.end(), id) != ids.end());
     }
-    CHECK(state["domain"] == 175);
+    CHECK(state["domain"] == domains::kDashboard);
     CHECK(state["attention"].empty());
 
     // An order's results: only the three files, of an order the cell has.
@@ -216,7 +219,7 @@ TEST_CASE("the dashboard takes orders: the operator's zip of a product becomes a
   using namespace std::chrono_literals;
   namespace fs = std::filesystem;
   const auto dir = test::scratch("dashboard-orders");
-  const std::string domain = "173";
+  const std::string domain = domains::text(domains::kDashboardTakesOrders);
   const DashboardCell cell = start_dashboard_cell(dir, domain);
   const int port = cell.port;
   const httplib::Headers bearer{{"Authorization", "Bearer " + cell.token}};
@@ -323,7 +326,7 @@ TEST_CASE("the operator takes a station out of service from the dashboard: the s
           "[process][cell][dashboard]") {
   using namespace std::chrono_literals;
   const auto dir = test::scratch("dashboard-service");
-  const std::string domain = "169";
+  const std::string domain = domains::text(domains::kOperatorTakesAStationOut);
   const DashboardCell cell = start_dashboard_cell(dir, domain);
   const httplib::Headers bearer{{"Authorization", "Bearer " + cell.token}};
   httplib::Client client("127.0.0.1", cell.port);

@@ -13,7 +13,10 @@
 
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
 #include "tests/support/order_twins.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -63,7 +66,8 @@ TEST_CASE("kills mid-order: the order is taken up, every part accounted for, sto
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("durable-state");
   const fs::path state_dir = dir / "state", log = dir / "up.log";
-  const std::string domain = "195", lego = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
+  const std::string domain = domains::text(domains::kKillsMidOrder);
+  const std::string lego = std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml";
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "20", "--state-dir",
                          state_dir.string()},
                         log.string());
@@ -203,7 +207,7 @@ void twin_signalled_mid_order(const std::string& name, const std::string& domain
 
 TEST_CASE("a twin killed during physical assembly is started again and finishes the order, no step done twice",
           "[process][cell][state]") {
-  const std::string domain = "197";
+  const std::string domain = domains::text(domains::kTwinResumes);
   twin_signalled_mid_order("twin-resume", domain, SIGKILL, {}, [&](const fs::path& dir, const std::string&, pid_t) {
     const json status = status_json(domain, dir);
     for (const auto& r : status["resources"]) CHECK(r["reserved_by"] == "");
@@ -215,7 +219,7 @@ TEST_CASE("a twin frozen during physical assembly falls silent: the desk ends it
   const fs::path cell = test::scratch("twin-frozen-cell") / "cell.yaml";
   std::ofstream(cell) << test::read_text(fs::path(DEPLOY_CELLS) / "default.yaml") << "\ntwin_watchdog: 5\n";
   // SIGSTOP: alive on DDS for its lease, its loop stopped: only its heartbeat tells.
-  twin_signalled_mid_order("twin-frozen", "176", SIGSTOP, {"--cell", cell.string()},
+  twin_signalled_mid_order("twin-frozen", domains::text(domains::kTwinFrozenDesk), SIGSTOP, {"--cell", cell.string()},
                            [](const fs::path&, const std::string& log, pid_t twin) {
                              CHECK(log.find("the twin of order tower runs but its heartbeat stopped") != std::string::npos);
                              CHECK(::kill(twin, 0) != 0);  // ended, not left stopped
@@ -227,7 +231,7 @@ TEST_CASE("a twin killed once a subassembly stands built aside: the next one ins
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("subassembly-resume");
   const fs::path state_dir = dir / "state", log = dir / "up.log";
-  const std::string domain = "202";
+  const std::string domain = domains::text(domains::kSubassemblyResumed);
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir",
                          state_dir.string()},
                         log.string());
@@ -261,7 +265,7 @@ TEST_CASE("cellctl down pauses the orders under way, and up on the same state ta
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("pause");
   const fs::path state_dir = dir / "state";
-  const std::string domain = "198";
+  const std::string domain = domains::text(domains::kDownPauses);
   const std::vector<std::string> up_args{CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10",
                                          "--state-dir", state_dir.string()};
   auto up = std::make_unique<test::ChildProcess>(up_args, (dir / "up-1.log").string());

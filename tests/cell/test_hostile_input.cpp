@@ -21,7 +21,10 @@
 #include "services/dds/endpoints.hpp"
 #include "simulationPubSubTypes.h"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
 #include "tests/support/hire.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -340,7 +343,7 @@ TEST_CASE("hostile: a translate to x = +inf is rejected", "[process][hostile]") 
 }
 
 TEST_CASE("hostile: a grip of negative, NaN or too wide an opening is rejected", "[process][hostile]") {
-  HostileCell cell(213, "bad-opening");
+  HostileCell cell(domains::kHostileOpening, "bad-opening");
   const std::string award = hire_arm_and_grip(cell);
   for (const double opening : {-0.01, std::nan(""), 5.0}) {
     cell::Command grip = command("rogue/grip-" + std::to_string(opening), "arm-1", "rogue", "grip", award);
@@ -356,7 +359,7 @@ TEST_CASE("hostile: a grip of negative, NaN or too wide an opening is rejected",
 
 TEST_CASE("hostile: a path of 1,000,000 waypoints is dropped by DDS, and no process keeps the memory",
           "[process][hostile]") {
-  HostileCell cell(214, "huge-path");
+  HostileCell cell(domains::kHostileHugePath, "huge-path");
   const auto before = cell.settled_rss();
   {
     // The intruder's own writer, whose buffers grow to whatever it writes.
@@ -385,7 +388,7 @@ TEST_CASE("hostile: a path of 1,000,000 waypoints is dropped by DDS, and no proc
 }
 
 TEST_CASE("hostile: a fetch for an order that hired no robot is rejected before the robot moves", "[process][hostile]") {
-  HostileCell cell(215, "unhired-fetch");
+  HostileCell cell(domains::kHostileUnhiredFetch, "unhired-fetch");
   cell::Command fetch = command("rogue/fetch", "mobile-robot-1", "rogue", "fetch", "rogue/robot");
   fetch.part("rogue/x");
   fetch.part_type("Unobtainium");
@@ -399,7 +402,7 @@ TEST_CASE("hostile: a fetch for an order that hired no robot is rejected before 
 }
 
 TEST_CASE("hostile: a give without an award is rejected and the stock stays", "[process][hostile]") {
-  HostileCell cell(216, "unawarded-give");
+  HostileCell cell(domains::kHostileUnawardedGive, "unawarded-give");
   const auto stock = [&] { return cell.capability("buffer-2").stock(); };
   const auto before = stock();
   cell::Command give = command("rogue/give", "buffer-2", "rogue", "give", "rogue/give/Brick2x4");
@@ -416,7 +419,7 @@ TEST_CASE("hostile: a give without an award is rejected and the stock stays", "[
 
 TEST_CASE("hostile: a command from an intruder while an order holds the arm is rejected, the order goes on",
           "[process][hostile]") {
-  HostileCell cell(217, "intruder-command");
+  HostileCell cell(domains::kHostileIntruderCommand, "intruder-command");
   auto ok1 = cell.start_order("ok1");
   REQUIRE(cell.order_reaches("ok1", cell::PHYSICAL_ASSEMBLY));
   cell::Command move = command("intruder/move", "arm-1", "intruder", "translate", "intruder/arm");
@@ -430,7 +433,7 @@ TEST_CASE("hostile: a command from an intruder while an order holds the arm is r
 }
 
 TEST_CASE("hostile: cell-sim refuses an intruder's changes to an order's parts, the order goes on", "[process][hostile]") {
-  HostileCell cell(218, "intruder-sim");
+  HostileCell cell(domains::kHostileIntruderSim, "intruder-sim");
   auto ok1 = cell.start_order("ok1");
   REQUIRE(cell.order_reaches("ok1", cell::PHYSICAL_ASSEMBLY));
   // A part of the order's in the physical cell, as the resources' events name it.
@@ -471,7 +474,7 @@ TEST_CASE("hostile: cell-sim refuses an intruder's changes to an order's parts, 
 
 TEST_CASE("hostile: a burst of 10,000 commands: each gets a final event, the station lives and gives its memory back",
           "[process][hostile]") {
-  HostileCell cell(219, "burst");
+  HostileCell cell(domains::kHostileBurst, "burst");
   const long before = cell.settled_rss().at("station");
   std::vector<std::string> written;
   const auto start = std::chrono::steady_clock::now();

@@ -10,6 +10,9 @@
 
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -45,7 +48,7 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
           "[process][cell][desk]") {
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("order-queue"), state = dir / "state";
-  const std::string domain = "231";
+  const std::string domain = domains::text(domains::kOrderQueue);
   const fs::path cell = cell_with_max_twins(dir, 2);
   const auto up_argv = [&] {
     return std::vector<std::string>{CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
@@ -63,7 +66,7 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
                          dir / (id + ".log"), 30s);
   };
   CHECK(detach("q4") == 2);  // no cell yet to hand it to
-  CHECK(test::read_text(dir / "q4.log").find("--detach hands the order to the cell of cellctl up, and none runs on domain 231") !=
+  CHECK(test::read_text(dir / "q4.log").find("--detach hands the order to the cell of cellctl up, and none runs on domain " + domain) !=
         std::string::npos);
   {
     state::CellStore store(state);
@@ -145,7 +148,7 @@ TEST_CASE("cancel: a queued order never starts, one in physical assembly fails w
           "and the cell builds the next", "[process][cell][desk]") {
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("cancel"), state = dir / "state";
-  const std::string domain = "172";
+  const std::string domain = domains::text(domains::kCancel);
   const fs::path cell = cell_with_max_twins(dir, 1);
   test::ChildProcess up({CELLCTL_EXE, "up", "--cell", cell.string(), "--domain", domain, "--real-time-factor", "10",
                          "--state-dir", state.string()},
@@ -218,7 +221,7 @@ TEST_CASE("cancel: an order whose twin is still planning ends within seconds of 
           "[process][cell][desk]") {
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("cancel-planning"), state = dir / "state";
-  const std::string domain = "207";
+  const std::string domain = domains::text(domains::kCancelWhilePlanning);
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--real-time-factor", "10", "--state-dir", state.string()},
                         (dir / "up.log").string());
   REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));

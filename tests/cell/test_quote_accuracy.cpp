@@ -20,6 +20,9 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -95,11 +98,11 @@ TEST_CASE("quotes come true: on generated cells each quote is near its physical 
     std::mt19937 random(7919 * (pair + 1));
     const fs::path dir = test::scratch("quote-accuracy-" + std::to_string(pair));
     const std::vector<std::string> names{"a", "b"};
-    const std::vector<int> domains{217, 222};  // no other test's: a cell-sim of another test answered an arm here once
+    const std::vector<int> cell_domains{domains::kQuoteAccuracyA, domains::kQuoteAccuracyB};
     std::vector<fs::path> files;
     for (std::size_t c = 0; c < 2; ++c) {
       files.push_back(dir / (names[c] + ".yaml"));
-      std::ofstream(files[c]) << random_cell(random, domains[c], factor);
+      std::ofstream(files[c]) << random_cell(random, cell_domains[c], factor);
     }
     INFO("pair " << pair << ": " << test::read_text(files[0]) << test::read_text(files[1]));
 
@@ -117,7 +120,7 @@ TEST_CASE("quotes come true: on generated cells each quote is near its physical 
                            "--out", (dir / "quotes").string()},
                           dir / "quote.log", 180s) == 0);
       for (std::size_t c = 0; c < 2; ++c) {
-        CHECK(test::cellctl({"down", "--domain", std::to_string(domains[c])}, dir / ("down-" + names[c] + ".log"), 30s) == 0);
+        CHECK(test::cellctl({"down", "--domain", std::to_string(cell_domains[c])}, dir / ("down-" + names[c] + ".log"), 30s) == 0);
         CHECK(ups[c]->wait_for_exit(20s) == 0);
       }
     }

@@ -9,6 +9,9 @@
 
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -38,8 +41,9 @@ TEST_CASE("quotes: two cells answer with time, cost and findings, the best by ti
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("quotes");
   // The thrifty cell has no 2x2 bricks: the Lego tower is not feasible there.
-  const fs::path fast = cell_file(dir, "fast", "228");
-  const fs::path thrifty = cell_file(dir, "thrifty", "180", {{"Brick2x2: 100", "Brick2x2: 0"}});
+  const fs::path fast = cell_file(dir, "fast", domains::text(domains::kQuotesFast));
+  const fs::path thrifty =
+      cell_file(dir, "thrifty", domains::text(domains::kQuotesThrifty), {{"Brick2x2: 100", "Brick2x2: 0"}});
   test::ChildProcess up_fast({CELLCTL_EXE, "up", "--cell", fast.string(), "--state-dir", (dir / "state-fast").string()},
                              (dir / "up-fast.log").string());
   test::ChildProcess up_thrifty({CELLCTL_EXE, "up", "--cell", thrifty.string(), "--state-dir", (dir / "state-thrifty").string()},
@@ -107,8 +111,8 @@ TEST_CASE("quotes: two cells answer with time, cost and findings, the best by ti
   REQUIRE(status["orders"].size() == 2);
   for (const auto& o : status["orders"]) CHECK(o["quote"] == true);
 
-  CHECK(test::cellctl({"down", "--domain", "228"}, dir / "down-fast.log", 30s) == 0);
-  CHECK(test::cellctl({"down", "--domain", "180"}, dir / "down-thrifty.log", 30s) == 0);
+  CHECK(test::cellctl({"down", "--domain", domains::text(domains::kQuotesFast)}, dir / "down-fast.log", 30s) == 0);
+  CHECK(test::cellctl({"down", "--domain", domains::text(domains::kQuotesThrifty)}, dir / "down-thrifty.log", 30s) == 0);
   CHECK(up_fast.wait_for_exit(20s) == 0);
   CHECK(up_thrifty.wait_for_exit(20s) == 0);
   // A quote takes no stock and leaves no part anywhere.

@@ -21,12 +21,15 @@
 
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
-#include "deskPubSubTypes.h"
 #include "deploy/cellctl/file_transfer.hpp"
+#include "deskPubSubTypes.h"
 #include "ordersPubSubTypes.h"
 #include "services/dds/endpoints.hpp"
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -91,7 +94,7 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
           "[process][security]") {
   const fs::path dir = test::scratch("pki-init");
   const fs::path pki = dir / "pki";
-  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--domain", "224"}, dir / "init.log") == 0);
+  REQUIRE(test::cellctl({"pki", "init", pki.string(), "--domain", domains::text(domains::kPki)}, dir / "init.log") == 0);
   INFO(test::read_text(dir / "init.log"));
   CHECK(mode_of(pki) == 0700);
   CHECK(mode_of(pki / "ca.key.pem") == 0600);
@@ -141,7 +144,7 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
 
   // A cell keeps its CA: a second init refuses and changes nothing.
   const std::string ca_key = test::read_text(pki / "ca.key.pem");
-  CHECK(test::cellctl({"pki", "init", pki.string(), "--domain", "224"}, dir / "again.log") == 1);
+  CHECK(test::cellctl({"pki", "init", pki.string(), "--domain", domains::text(domains::kPki)}, dir / "again.log") == 1);
   CHECK(test::read_text(dir / "again.log").find("ca.key.pem exists") != std::string::npos);
   CHECK(test::read_text(pki / "ca.key.pem") == ca_key);
   // What another host gets: the CA's certificate, the governance and one identity, its key 0600.
@@ -153,7 +156,8 @@ TEST_CASE("pki init: a CA, the governance, and per identity a key only its owner
   CHECK_FALSE(fs::exists(dir / "for-buffer-1" / "identities" / "buffer-2"));
   CHECK(test::cellctl({"pki", "export", pki.string(), "buffer-1", (dir / "for-buffer-1").string()}, dir / "export2.log") == 2);
   // An identity the cell does not have is not issued.
-  CHECK(test::cellctl({"pki", "issue", pki.string(), "buffer-9", "--domain", "224"}, dir / "issue.log") == 2);
+  CHECK(test::cellctl({"pki", "issue", pki.string(), "buffer-9", "--domain", domains::text(domains::kPki)}, dir / "issue.log") ==
+        2);
   CHECK(test::read_text(dir / "issue.log").find("buffer-9 is no identity of the cell") != std::string::npos);
 }
 
@@ -161,7 +165,7 @@ TEST_CASE("secure cell: orders are assembled, and without a certificate, with a 
           "[process][security][cell]") {
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("secure-cell");
-  const std::string domain = "225";
+  const std::string domain = domains::text(domains::kSecureCell);
   const fs::path pki = dir / "pki", foreign = dir / "foreign", stale = dir / "stale";
   REQUIRE(test::cellctl({"pki", "init", pki.string(), "--domain", domain}, dir / "init.log") == 0);
   REQUIRE(test::cellctl({"pki", "init", foreign.string(), "--domain", domain}, dir / "foreign.log") == 0);
@@ -432,7 +436,7 @@ TEST_CASE("secure dashboard: HTTPS with the cell's CA, an operator's certificate
   // A client of a server that ends the handshake: its next write must fail, not end the test.
   std::signal(SIGPIPE, SIG_IGN);
   const fs::path dir = test::scratch("secure-dashboard");
-  const std::string domain = "223";
+  const std::string domain = domains::text(domains::kSecureDashboard);
   const fs::path cell = dir / "cell.yaml", pki = dir / "pki", foreign = dir / "foreign";
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nsecurity: pki\noperators: [alice]\n";
   REQUIRE(test::cellctl({"pki", "init", pki.string(), "--cell", cell.string(), "--domain", domain}, dir / "init.log") == 0);
@@ -510,7 +514,7 @@ TEST_CASE("order desk: a client submits over DDS-Security and gets its results, 
           "[process][security][desk]") {
   test::clean_stale_dds_segments();
   const fs::path dir = test::scratch("order-desk");
-  const std::string domain = "226";
+  const std::string domain = domains::text(domains::kOrderDesk);
   // The default cell, with a desk that takes 50 kB (the Lego tower, not Cranfield), one
   // order a minute per client and one order queued or under way in the cell.
   std::string yaml = test::read_text(DEFAULT_CELL);

@@ -11,6 +11,9 @@
 
 #include "services/state/cell_store.hpp"
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -25,7 +28,7 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
   // The default cell on a domain of its own, allowed two restarts of a process a minute.
   const fs::path cell = dir / "cell.yaml";
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nrestart: {limit: 2, window: 60}\n";
-  const std::string domain = "220";
+  const std::string domain = domains::text(domains::kUpRestarts);
   const fs::path log = dir / "up.log";
   test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain, "--state-dir", (dir / "state").string()},
                         log.string());
@@ -69,7 +72,7 @@ TEST_CASE("cellctl up restarts a process that dies, and gives up on one that kee
 TEST_CASE("cellctl up ends and restarts a process that runs but is not heard (a hung one), and the cell goes on",
           "[process][cell]") {
   const fs::path dir = test::scratch("unheard");
-  const std::string domain = "230";
+  const std::string domain = domains::text(domains::kUpHung);
   const fs::path log = dir / "up.log";
   // --wait: how long a process may go unheard, here 5 s after its 5 s liveliness lease.
   test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domain, "--wait", "5", "--state-dir", (dir / "state").string()},
@@ -100,7 +103,7 @@ TEST_CASE("cellctl up with two discovery servers: one killed is started again, a
           "clients find the cell through the other",
           "[process][cell][discovery]") {
   const fs::path dir = test::scratch("two-servers");
-  const std::string domain = "206";
+  const std::string domain = domains::text(domains::kTwoDiscoveryServers);
   const fs::path cell = dir / "cell.yaml", log = dir / "up.log";
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\ndiscovery: {servers: [127.0.0.1:12406, 127.0.0.1:12407]}\n";
   test::ChildProcess up({CELLCTL_EXE, "up", cell.string(), "--domain", domain, "--real-time-factor", "50", "--state-dir",
@@ -150,13 +153,13 @@ TEST_CASE("cellctl up with two discovery servers: one killed is started again, a
 TEST_CASE("cellctl up: one cell per domain, and after an up that was killed, down says so and up starts afresh",
           "[process][cell]") {
   const fs::path dir = test::scratch("up-killed");
-  const std::string domain = "221";
+  const std::string domain = domains::text(domains::kOneCellPerDomain);
   const fs::path log = dir / "up.log";
   auto up = std::make_unique<test::ChildProcess>(std::vector<std::string>{CELLCTL_EXE, "up", "--domain", domain, "--state-dir", (dir / "state").string()},
                                                  log.string());
   REQUIRE(test::appears(log, "cell up on domain"));
   CHECK(test::cellctl({"up", "--domain", domain}, dir / "second.log", 30s) == 1);
-  CHECK(test::read_text(dir / "second.log").find("a cell runs on domain 221 already") != std::string::npos);
+  CHECK(test::read_text(dir / "second.log").find("a cell runs on domain " + domain + " already") != std::string::npos);
 
   // cellctl up dies hard: its processes end with it (they asked for SIGTERM when their parent goes).
   const auto children = test::children_of(up->pid());
@@ -194,7 +197,9 @@ TEST_CASE("cellctl up refuses a cell that would pass a limit of the host, says w
   yaml.replace(yaml.find("max_twins: 16"), 13, "max_twins: 40");
   const fs::path cell = dir / "cell.yaml";
   std::ofstream(cell) << yaml;
-  CHECK(test::cellctl({"up", cell.string(), "--domain", "232", "--state-dir", (dir / "state").string()}, dir / "up.log", 30s) == 2);
+  CHECK(test::cellctl({"up", cell.string(), "--domain", domains::text(domains::kUpPastAHostLimit), "--state-dir",
+                       (dir / "state").string()},
+                      dir / "up.log", 30s) == 2);
   const std::string log = test::read_text(dir / "up.log");
   INFO(log);
   CHECK(log.find("47 DDS participants on this host (5 processes, 40 twins at once, 1 standing by, cellctl) pass the 28 that "

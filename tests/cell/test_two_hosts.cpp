@@ -18,6 +18,9 @@
 #include <catch2/catch.hpp>
 
 #include "tests/support/cell_test.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -72,7 +75,7 @@ TEST_CASE("two hosts: an OEM in one network namespace submits Cranfield to a sec
   REQUIRE(hosts.ok());
   const Net& n = hosts.net();
   const fs::path dir = test::scratch("two-hosts");
-  const std::string domain = "227";
+  const std::string domain = domains::text(domains::kTwoHosts);
   const fs::path cell = dir / "cell.yaml", pki = dir / "pki";
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nnetwork: {interfaces: [" << n.cell_ip << "], peers: [" << n.oem_ip
                       << "]}\nsecurity: pki\n";
@@ -115,7 +118,8 @@ TEST_CASE("two hosts: a discovery server on each; the OEM host's server killed w
   REQUIRE(hosts.ok());
   const Net& n = hosts.net();
   const fs::path dir = test::scratch("two-hosts-servers");
-  const std::string domain = "208", port = std::to_string(11811 + 208);
+  const std::string domain = domains::text(domains::kTwoHostsServers);
+  const std::string port = std::to_string(11811 + domains::kTwoHostsServers);
   const fs::path cell = dir / "cell.yaml", state = dir / "state";
   std::ofstream(cell) << test::read_text(DEFAULT_CELL) << "\nnetwork: {interfaces: [" << n.cell_ip << "], peers: [" << n.oem_ip
                       << "]}\ndiscovery: server\n";

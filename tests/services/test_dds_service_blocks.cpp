@@ -13,6 +13,9 @@
 #include "commandsPubSubTypes.h"
 #include "services/dds/service_blocks.hpp"
 #include "services/runtime/block_test_fixture.hpp"
+#include "tests/support/domains.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -46,7 +49,7 @@ bool run_until(fb::Resource& resource, const fb::EventRecorder& recorder, std::s
 }  // namespace
 
 TEST_CASE("an event published by one block arrives at a subscribing block", "[dds]") {
-  const dds::ParticipantSettings settings{171, true, {}};
+  const dds::ParticipantSettings settings{domains::kDdsEvents, true, {}};
   auto twin = dds::make_participant("test-twin", settings);
   auto station = dds::make_participant("test-station", settings);
 
@@ -69,7 +72,7 @@ TEST_CASE("an event published by one block arrives at a subscribing block", "[dd
 }
 
 TEST_CASE("state topics: a late reader sees the last state, and a dead writer is noticed", "[dds]") {
-  const dds::ParticipantSettings settings{172, true, {}};
+  const dds::ParticipantSettings settings{domains::kDdsStateTopics, true, {}};
   auto twin = dds::make_participant("test-twin", settings);
   auto buffer = dds::make_participant("test-buffer", settings);
   dds::QosSettings quick;
@@ -119,7 +122,7 @@ TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers i
     }
     ~OwnThreads() { eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(before); }
   } own_threads;
-  const dds::ParticipantSettings settings{173, true, {}};
+  const dds::ParticipantSettings settings{domains::kDdsOutbox, true, {}};
   auto station = dds::make_participant("test-station", settings);
   auto twin = dds::make_participant("test-twin", settings);
   dds::QosSettings small;

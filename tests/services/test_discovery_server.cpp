@@ -15,7 +15,10 @@
 #include "services/dds/endpoints.hpp"
 #include "services/dds/participant.hpp"
 #include "tests/support/child_process.hpp"
+#include "tests/support/domains.hpp"
 #include "tests/support/sanitizers.hpp"
+
+namespace domains = test::domains;
 
 namespace {
 
@@ -24,7 +27,7 @@ using Probe = cell::Clock;
 
 dds::ParticipantSettings settings(int serve) {
   dds::ParticipantSettings s;
-  s.domain_id = 170;
+  s.domain_id = domains::kDiscoveryServer;
   s.discovery.servers = {"127.0.0.1:21170"};
   s.discovery.serve = serve;
   if (serve >= 0) s.discovery.announce_every_s = 0.001;

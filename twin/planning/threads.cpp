@@ -159,7 +159,7 @@ bool ridged(const std::vector<Vec3>& vertices, const Fit& fit, double pitch) {
 // The turn in the phase makes the sum small at the pitch's multiples and fractions, and for a
 // ring (a plain shaft's edge). All the surface's vertices weighted by their relief are not as
 // good: their flanks' vertices, unevenly many, pull the pitch (FurnitureBench's printed legs,
-// 9.41 mm: 8.6-8.7 so, at a coherence of 0.3; 9.41 by their crests, at 0.98).
+// 9.41 mm by hand: 8.6-8.7 so, at a coherence of 0.3; by their crests 9.3-9.8, at 0.7-0.9).
 struct MeasuredPitch {
   double pitch = 0;      // m
   double coherence = 0;  // |sum| / count: near 1 for a clean thread, near 0 for none
