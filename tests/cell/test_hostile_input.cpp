@@ -23,6 +23,7 @@
 #include "tests/support/cell_test.hpp"
 #include "tests/support/domains.hpp"
 #include "tests/support/hire.hpp"
+#include "tests/support/sanitizers.hpp"
 
 namespace domains = test::domains;
 
@@ -30,14 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-// A sanitizer's allocator keeps freed memory (ASan's quarantine, TSan's shadow and history):
-// resident memory says nothing about the program's there.
-#ifdef CELL_UNDER_SANITIZER
-constexpr bool kUnderSanitizer = true;
-#else
-constexpr bool kUnderSanitizer = false;
-#endif
 
 
 cell::Pose pose(double x, double y, double z, double qw = 1, double qx = 0, double qy = 0, double qz = 0) {
@@ -494,7 +487,7 @@ TEST_CASE("hostile: a burst of 10,000 commands: each gets a final event, the sta
   std::this_thread::sleep_for(2s);
   const long after = cell.rss().at("station");
   INFO("station " << before << " kB before, " << after << " kB after");
-  if (kUnderSanitizer) {
+  if (test::kUnderSanitizers) {
     WARN("memory not checked under a sanitizer");
   } else {
     // What stays is the allocator's and DDS's, not the burst's: 1.8-2.8 MB after 10,000

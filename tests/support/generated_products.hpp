@@ -170,11 +170,12 @@ class ProductMaker {
     product_.meshes.push_back(std::make_shared<const sim::TriangleMesh>(std::move(mesh)));
     product_.held_by.push_back(nullptr);
   }
-  // `joint`: what the second part's interface declares ("" for contact).
-  void link(const std::string& a, const std::string& b, const std::string& joint = "") {
+  // `joint`: what the second part's interface declares ("" for contact); `pitch`, a screw's.
+  void link(const std::string& a, const std::string& b, const std::string& joint = "", double pitch = 0) {
     if (!joint.empty()) {
       twin::Joint j;
       j.kind = *twin::joint_kind(joint);
+      j.pitch = pitch;
       product_.product.parts()[*product_.product.find_part(b)].own_joints["to_" + a] = j;
     }
     for (const auto& [self, other] : {std::pair{a, b}, std::pair{b, a}}) {

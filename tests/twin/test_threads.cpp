@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 
+#include "tests/support/generated_products.hpp"
 #include "tests/support/meshes.hpp"
 #include "tests/twin/test_support.hpp"
 #include "twin/planning/assembly_planner.hpp"
@@ -27,16 +28,15 @@ double ridge(double t, double y, double pitch = kPitch) {
   return std::abs(2 * (u - std::floor(u)) - 1);
 }
 
-struct PartsAtOrigin {
-  twin::LoadedProduct loaded{twin::Product("made", "made.aml"), {}, {}};
-  PartsAtOrigin& part(const std::string& name, sim::TriangleMesh mesh) {
-    twin::DigitalPart p;
-    p.id = p.name = name;
-    loaded.product.add_part(p);
-    loaded.meshes.push_back(std::make_shared<const sim::TriangleMesh>(std::move(mesh)));
-    return *this;
-  }
-};
+// A bolt and a nut at the product's origin; `screw_pitch`: a screw link between them that
+// declares it (none: 0).
+twin::LoadedProduct bolt_and_nut(sim::TriangleMesh bolt_mesh, sim::TriangleMesh nut_mesh, double screw_pitch = 0) {
+  test::ProductMaker make("made");
+  make.part("bolt", std::move(bolt_mesh));
+  make.part("nut", std::move(nut_mesh));
+  if (screw_pitch > 0) make.link("bolt", "nut", "screw", screw_pitch);
+  return make.take();
+}
 
 // Rings of vertices an eighth of the pitch apart along the axis.
 int levels(double length, double pitch) { return static_cast<int>(std::lround(8 * length / pitch)); }
@@ -63,11 +63,10 @@ sim::TriangleMesh nut(bool threaded, double pitch = kPitch) {
 
 TEST_CASE("threads: a nut modelled with its thread into its bolt's is a thread round the bolt's axis, a plain ring on a plain rod is not",
           "[threads]") {
-  PartsAtOrigin threaded;
-  threaded.part("bolt", bolt()).part("nut", nut(true));
-  const auto check = twin::find_interferences(threaded.loaded);
+  const twin::LoadedProduct threaded = bolt_and_nut(bolt(), nut(true));
+  const auto check = twin::find_interferences(threaded);
   REQUIRE(check.overlaps.size() == 1);
-  const auto thread = twin::thread_of(threaded.loaded, check.overlaps.front());
+  const auto thread = twin::thread_of(threaded, check.overlaps.front());
   REQUIRE(thread);
   CHECK(std::abs(thread->axis.dot(twin::Vec3::UnitY())) == Approx(1).margin(1e-3));
   CHECK(thread->centre.x() == Approx(0).margin(2e-4));
@@ -77,29 +76,27 @@ TEST_CASE("threads: a nut modelled with its thread into its bolt's is a thread r
   CHECK(thread->pitch_measured);
   CHECK_FALSE(thread->left_hand);
   CHECK(thread->length == Approx(0.008).margin(1e-3));
-  CHECK(twin::describe(threaded.loaded.product, *thread).rfind("nut in bolt: a thread of 14.", 0) == 0);
+  CHECK(twin::describe(threaded.product, *thread).rfind("nut in bolt: a thread of 14.", 0) == 0);
 
   // A plain ring on a plain rod overlaps as much, and has no thread.
-  PartsAtOrigin plain;
-  plain.part("bolt", bolt(false)).part("nut", nut(false));
-  const auto overlaps = twin::find_interferences(plain.loaded).overlaps;
+  const twin::LoadedProduct plain = bolt_and_nut(bolt(false), nut(false));
+  const auto overlaps = twin::find_interferences(plain).overlaps;
   REQUIRE(overlaps.size() == 1);
-  CHECK_FALSE(twin::thread_of(plain.loaded, overlaps.front()));
+  CHECK_FALSE(twin::thread_of(plain, overlaps.front()));
 }
 
 TEST_CASE("threads: the nut is turned onto the bolt along the thread and verified, a helix off the axis or of the other hand is not",
           "[threads][planning]") {
-  PartsAtOrigin m;
-  m.part("bolt", bolt()).part("nut", nut(true));
+  const twin::LoadedProduct m = bolt_and_nut(bolt(), nut(true));
   twin::SearchSequencePlanner sequence;
   twin::LinearPathPlanner path;
-  const twin::Plan plan = twin::plan_assembly(m.loaded, sequence, path);
+  const twin::Plan plan = twin::plan_assembly(m, sequence, path);
   for (const auto& f : plan.findings) UNSCOPED_INFO(f.kind + ": " + f.message);
   REQUIRE(plan.complete);
   REQUIRE(plan.steps.size() == 2);
   CHECK(plan.verification.passed);
   const twin::PlanStep& step = plan.steps[1];
-  CHECK(m.loaded.product.parts()[step.part].name == "nut");
+  CHECK(m.product.parts()[step.part].name == "nut");
   REQUIRE(step.trajectory.screw);
   CHECK(step.trajectory.screw->mate == 0);
   CHECK(step.trajectory.direction.y() == Approx(-1));  // down the bolt
@@ -116,7 +113,7 @@ TEST_CASE("threads: the nut is turned onto the bolt along the thread and verifie
       p.part.translation().x() += 0.001;
       p.gripper.translation().x() += 0.001;
     }
-    const auto v = twin::verify_plan(m.loaded, off);
+    const auto v = twin::verify_plan(m, off);
     REQUIRE(v.violations.size() == 1);
     CHECK(v.violations[0].member == "nut");
     CHECK(v.violations[0].step == 2);
@@ -125,7 +122,7 @@ TEST_CASE("threads: the nut is turned onto the bolt along the thread and verifie
   }
   SECTION("turned the wrong way, a left-hand helix goes into the bolt") {
     twin::Plan left = plan;
-    const auto& final_pose = m.loaded.product.parts()[1].final_pose;
+    const auto& final_pose = m.product.parts()[1].final_pose;
     for (auto& p : left.steps[1].trajectory.waypoints) {
       if (p.phase != "screw") continue;
       // The same height, the turn mirrored: R(-a) where the plan has R(a).
@@ -134,7 +131,7 @@ TEST_CASE("threads: the nut is turned onto the bolt along the thread and verifie
       p.part.linear() = Eigen::AngleAxisd(-turn.angle(), turn.axis()).toRotationMatrix();
       p.gripper = p.part * grip;
     }
-    const auto v = twin::verify_plan(m.loaded, left);
+    const auto v = twin::verify_plan(m, left);
     REQUIRE(v.violations.size() == 1);
     CHECK(v.violations[0].member == "nut");
     CHECK(v.violations[0].phase == "screw");
@@ -143,11 +140,10 @@ TEST_CASE("threads: the nut is turned onto the bolt along the thread and verifie
 }
 
 TEST_CASE("threads: a plain ring overlapping a plain rod is an interference, and no plan holds both", "[threads][planning]") {
-  PartsAtOrigin m;
-  m.part("bolt", bolt(false)).part("nut", nut(false));
+  const twin::LoadedProduct m = bolt_and_nut(bolt(false), nut(false));
   twin::SearchSequencePlanner sequence;
   twin::LinearPathPlanner path;
-  const twin::Plan plan = twin::plan_assembly(m.loaded, sequence, path);
+  const twin::Plan plan = twin::plan_assembly(m, sequence, path);
   CHECK_FALSE(plan.complete);
   CHECK(plan.steps.size() == 1);
   CHECK(std::none_of(plan.findings.begin(), plan.findings.end(), [](const twin::Finding& f) { return f.kind == "thread"; }));
@@ -155,19 +151,18 @@ TEST_CASE("threads: a plain ring overlapping a plain rod is an interference, and
 
 TEST_CASE("threads: a fine thread is turned at the pitch it is modelled with, measured on its surface, not at ISO's coarse one",
           "[threads][planning]") {
-  PartsAtOrigin m;
-  m.part("bolt", bolt(true, kFine)).part("nut", nut(true, kFine));
-  const auto overlaps = twin::find_interferences(m.loaded).overlaps;
+  const twin::LoadedProduct m = bolt_and_nut(bolt(true, kFine), nut(true, kFine));
+  const auto overlaps = twin::find_interferences(m).overlaps;
   REQUIRE(overlaps.size() == 1);
-  const auto thread = twin::thread_of(m.loaded, overlaps.front());
+  const auto thread = twin::thread_of(m, overlaps.front());
   REQUIRE(thread);
   CHECK(thread->pitch == Approx(kFine).epsilon(0.01));
   CHECK(thread->pitch_measured);
-  CHECK(twin::describe(m.loaded.product, *thread).find("pitch 1.50 mm (measured on the model)") != std::string::npos);
+  CHECK(twin::describe(m.product, *thread).find("pitch 1.50 mm (measured on the model)") != std::string::npos);
 
   twin::SearchSequencePlanner sequence;
   twin::LinearPathPlanner path;
-  const twin::Plan plan = twin::plan_assembly(m.loaded, sequence, path);
+  const twin::Plan plan = twin::plan_assembly(m, sequence, path);
   for (const auto& f : plan.findings) UNSCOPED_INFO(f.kind + ": " + f.message);
   REQUIRE(plan.complete);
   CHECK(plan.verification.passed);
@@ -175,12 +170,8 @@ TEST_CASE("threads: a fine thread is turned at the pitch it is modelled with, me
   CHECK(plan.steps[1].trajectory.screw->pitch == Approx(kFine).epsilon(0.01));
 
   SECTION("a link that says the thread is ISO's coarse pitch, 2 mm, is refused by the replay") {
-    auto& nut_part = m.loaded.product.parts()[1];
-    nut_part.own_interfaces["thread"] = twin::Frame{};
-    nut_part.own_joints["thread"] = twin::Joint{twin::Joint::Kind::screw, kPitch, {}};
-    m.loaded.product.parts()[0].own_interfaces["thread"] = twin::Frame{};
-    m.loaded.product.connect("bolt", "thread", "nut", "thread", "bolt-nut", {});
-    const twin::Plan declared = twin::plan_assembly(m.loaded, sequence, path);
+    const twin::LoadedProduct linked = bolt_and_nut(bolt(true, kFine), nut(true, kFine), kPitch);
+    const twin::Plan declared = twin::plan_assembly(linked, sequence, path);
     CHECK_FALSE(declared.complete);
     CHECK(test::has_finding(declared, "verification", "nut"));
   }
