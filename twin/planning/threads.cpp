@@ -22,6 +22,8 @@ constexpr double kShellSlack = 2e-4;
 // from them (measure_pitch's coherence; docs/performance.md has the figures of ours and the
 // real set's).
 constexpr double kClearWave = 0.7;
+// Slices along the axis a finest pitch holds, in measure_pitch's sums.
+constexpr double kSlicesAPitch = 32;
 
 // ISO 261 coarse series: nominal diameter and pitch, mm.
 constexpr std::array<std::pair<double, double>, 23> kCoarse{{{1, 0.25},  {1.2, 0.25}, {1.6, 0.35}, {2, 0.4},   {2.5, 0.45},
@@ -175,7 +177,7 @@ MeasuredPitch sharpest_helix(const std::vector<std::pair<double, double>>& point
   // The points in thin slices along the axis, each slice's e^(∓iθ) summed (either hand);
   // what does not change along the axis (a line through the points a little off their
   // centre) taken out, or its wide peak at no pitch pulls the thread's.
-  const double slice = finest / 32;
+  const double slice = finest / kSlicesAPitch;
   const auto slices = static_cast<std::size_t>(std::ceil((high - low) / slice)) + 1;
   std::array<std::vector<std::complex<double>>, 2> sliced;
   std::vector<double> count(slices, 0);
@@ -225,6 +227,11 @@ std::optional<MeasuredPitch> measure_pitch(const std::vector<Vec3>& vertices, co
   const double finest = std::max(kFinest, guess / 4), coarsest = std::min(kCoarsest, guess * 4);
   // The thread beyond the overlap, too: the more turns, the sharper the pitch.
   const double low = fit.low - 10 * guess, high = fit.high + 10 * guess;
+  // The slices and the pitches tried both grow with the span over the finest pitch: a span
+  // past this many slices (a thread metres long, from a hostile or mis-scaled model) is not
+  // measured, and ISO's pitch is taken, rather than the planning stalling on it.
+  constexpr double kMostSlices = 16384;  // a 30 mm thread of 2 mm pitch: about 2 000
+  if ((high - low) / (finest / kSlicesAPitch) > kMostSlices) return std::nullopt;
   const Vec3 u = fit.line.axis.unitOrthogonal(), v = fit.line.axis.cross(u);
   std::vector<Vec3> samples;  // the vertices of the thread's band of radii
   for (const Vec3& p : vertices) {
