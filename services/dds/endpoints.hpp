@@ -31,6 +31,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "services/dds/liveliness_keeper.hpp"
 #include "services/dds/participant.hpp"
 #include "services/dds/qos.hpp"
 #include "services/dds/twin_bindings.hpp"
@@ -134,9 +135,15 @@ class Writer : private fdds::DataWriterListener {
     publisher_ = participant_->create_publisher(with_partitions(fdds::PUBLISHER_QOS_DEFAULT, partitions));
     writer_ = publisher_->create_datawriter(topic_on<PubSubType>(*participant_, topic), writer_qos(kind, settings), this);
     if (!writer_) throw std::runtime_error("cannot create a writer on " + topic + refusal_reason(*participant_));
+    if (kind == TopicKind::state) {
+      kept_alive_ = true;
+      LivelinessKeeper::of_this_process().keep(
+          writer_, std::chrono::milliseconds(static_cast<long>(settings.liveliness_lease_s * 1000 / 3)));
+    }
   }
   // A matched callback already under way finishes first; later ones find the writer closed.
   ~Writer() override {
+    if (kept_alive_) LivelinessKeeper::of_this_process().forget(writer_);
     writer_->set_listener(nullptr);
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -190,6 +197,7 @@ class Writer : private fdds::DataWriterListener {
   ParticipantPtr participant_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::DataWriter* writer_ = nullptr;
+  bool kept_alive_ = false;
   std::mutex mutex_;
   std::condition_variable matched_changed_;
   int matched_ = 0;

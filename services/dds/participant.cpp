@@ -231,7 +231,7 @@ ParticipantPtr make_participant(const std::string& name, const ParticipantSettin
   // The discovery lease stays Fast DDS's 20 s: with 5 s, a process starved of CPU for 5 s
   // (ten twins under ThreadSanitizer on two cores) was dropped by the others, and the pair
   // did not match again: every answer of a live buffer to one twin was lost. A process that
-  // dies is noticed by the 5 s liveliness of its capability, not by this lease.
+  // dies is noticed by the 5 s liveliness of its state writers (LivelinessKeeper).
   qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
       eprosima::fastrtps::Duration_t(settings.discovery.announce_every_s);
   qos.wire_protocol().builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(20.0);

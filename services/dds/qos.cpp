@@ -23,9 +23,9 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
     qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = KEEP_LAST_HISTORY_QOS;
     qos.history().depth = 1;
-    qos.liveliness().kind = AUTOMATIC_LIVELINESS_QOS;
+    // Asserted per writer by the LivelinessKeeper (liveliness_keeper.hpp says why not AUTOMATIC).
+    qos.liveliness().kind = MANUAL_BY_TOPIC_LIVELINESS_QOS;
     qos.liveliness().lease_duration = eprosima::fastrtps::Duration_t(settings.liveliness_lease_s);
-    qos.liveliness().announcement_period = eprosima::fastrtps::Duration_t(settings.liveliness_lease_s / 3);
   } else {
     qos.durability().kind = VOLATILE_DURABILITY_QOS;
     qos.history().kind = KEEP_ALL_HISTORY_QOS;

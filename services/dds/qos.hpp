@@ -1,8 +1,8 @@
 #pragma once
 // Every topic's QoS, in one place. Two kinds of topic carry the cell's traffic:
 //  - state (capabilities, order status, the clock): keyed, reliable, transient-local, the
-//    last sample per instance, writer liveliness with a lease, so late joiners see the
-//    current state and a dead writer's instances go NOT_ALIVE_NO_WRITERS;
+//    last sample per instance, writer liveliness with a lease (kept by LivelinessKeeper), so
+//    late joiners see the current state and a dead writer's instances go NOT_ALIVE_NO_WRITERS;
 //  - events (commands, command events, negotiation messages): unkeyed, reliable, volatile,
 //    every sample kept until taken, up to a bound.
 // Samples live in buffers of their type's largest size: an oversized one is dropped on arrival.

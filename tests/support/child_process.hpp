@@ -43,7 +43,17 @@ class ChildProcess {
       posix_spawn_file_actions_addopen(&actions, 1, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       posix_spawn_file_actions_adddup2(&actions, 1, 2);
     }
-    const int failed = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    // A process group of its own, whose leader's parent (this test) is in another group of the
+    // session: the group is never orphaned while the test runs. In an orphaned group, the
+    // exit of any member sends SIGHUP to all when one is stopped: a test's SIGSTOPped (hung)
+    // process was so ended by its neighbours' exits where ctest's own group was orphaned
+    // (ctest started in the background by a shell that has left).
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    posix_spawnattr_setpgroup(&attributes, 0);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    const int failed = posix_spawn(&pid_, args[0], &actions, &attributes, args.data(), environ);
+    posix_spawnattr_destroy(&attributes);
     posix_spawn_file_actions_destroy(&actions);
     if (failed != 0) throw std::runtime_error("cannot start " + argv[0]);
   }
