@@ -54,9 +54,10 @@ const json& resource(const json& status, const std::string& id) {
 void kill_and_wait_restart(pid_t up, const std::string& argument, const fs::path& log, int restart) {
   const pid_t pid = test::child_with_argument(up, argument);
   REQUIRE(pid > 0);
+  const std::size_t before_kill = test::read_text(log).size();
   ::kill(pid, SIGKILL);
-  REQUIRE(test::appears(log, argument + " restarted (pid"));
-  REQUIRE(test::appears(log, "restart " + std::to_string(restart) + ")"));
+  REQUIRE(test::appears(log, argument + " restarted (pid", std::chrono::seconds(30), before_kill));
+  REQUIRE(test::appears(log, "restart " + std::to_string(restart) + ")", std::chrono::seconds(30), before_kill));
 }
 
 }  // namespace

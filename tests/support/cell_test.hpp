@@ -69,11 +69,13 @@ inline std::string error_lines(const std::string& log) {
 }
 
 // Waits until the text shows up in the file (a process's log).
+// `from`: where in the file to look from (its size before what the test waits for began: a
+// line of the same words from earlier, a restart at start-up, does not count).
 inline bool appears(const std::filesystem::path& file, const std::string& text,
-                    std::chrono::seconds timeout = std::chrono::seconds(30)) {
+                    std::chrono::seconds timeout = std::chrono::seconds(30), std::size_t from = 0) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < deadline) {
-    if (read_text(file).find(text) != std::string::npos) return true;
+    if (read_text(file).find(text, from) != std::string::npos) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   return false;
