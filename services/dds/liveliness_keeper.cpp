@@ -13,8 +13,9 @@ LivelinessKeeper& LivelinessKeeper::of_this_process() {
 
 void LivelinessKeeper::keep(eprosima::fastdds::dds::DataWriter* writer, std::chrono::milliseconds period) {
   std::lock_guard<std::mutex> lock(mutex_);
-  kept_.push_back({writer, std::max(period, std::chrono::milliseconds(1)), std::chrono::steady_clock::now() + period});
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });  // first: if it throws, nothing is kept
+  period = std::max(period, std::chrono::milliseconds(1));
+  kept_.push_back({writer, period, std::chrono::steady_clock::now() + period});
   changed_.notify_all();
 }
 
@@ -40,7 +41,9 @@ void LivelinessKeeper::run() {
     auto next = now + std::chrono::hours(1);
     for (Kept& k : kept_) {
       if (k.next <= now) {
-        k.writer->assert_liveliness();  // sends a heartbeat: never blocks on a reader
+        // A heartbeat to its readers; to a reader in this process it is delivered on this
+        // thread, whose callbacks may run here (hence keep and forget never from a callback).
+        k.writer->assert_liveliness();
         k.next = now + k.period;
       }
       next = std::min(next, k.next);

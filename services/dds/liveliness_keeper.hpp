@@ -27,7 +27,8 @@ class LivelinessKeeper {
   static LivelinessKeeper& of_this_process();
 
   // From now on, until forget(writer) returns, `writer`'s liveliness is asserted every
-  // `period`.
+  // `period`. Neither keep nor forget may be called from a DDS callback: the keeper's thread
+  // may be the one delivering it (a reader in this process of a kept writer) and holds its lock.
   void keep(eprosima::fastdds::dds::DataWriter* writer, std::chrono::milliseconds period);
   // Once this returns, the keeper no longer touches `writer` (it may be deleted).
   void forget(eprosima::fastdds::dds::DataWriter* writer);
