@@ -460,7 +460,7 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
 
   SECTION("nothing comes: the twin gives up with a clear message") {
     test::ChildProcess twin({TWIN_EXE, "--domain", domains::text(domains::kTwinAlone), "--order", "alone", "--product", product,
-                             "--out",                             (dir / "alone").string(), "--wait", "2"},
+                             "--out", (dir / "alone").string(), "--wait", "2"},
                             (dir / "alone.log").string());
     CHECK(twin.wait_for_exit(30s) == 1);
     const std::string log = read_text(dir / "alone.log");
@@ -469,7 +469,7 @@ TEST_CASE("twin before the cell: it waits, bounded, and says what it misses", "[
   }
   SECTION("the cell comes later: the twin goes on and assembles") {
     test::ChildProcess twin({TWIN_EXE, "--domain", domains::text(domains::kTwinBeforeTheCell), "--order", "early", "--product",
-                             product, "--out",                             (dir / "early").string(), "--wait", "60"},
+                             product, "--out", (dir / "early").string(), "--wait", "60"},
                             (dir / "early.log").string());
     std::this_thread::sleep_for(1s);
     test::ChildProcess up({CELLCTL_EXE, "up", "--domain", domains::text(domains::kTwinBeforeTheCell), "--real-time-factor", "50",
@@ -588,8 +588,7 @@ TEST_CASE("cell run: a twin frozen during physical assembly falls silent: run en
   std::ofstream(dir / "cell.yaml") << read_text(kCell) << "\ntwin_watchdog: 5\n";
   test::ChildProcess run({CELLCTL_EXE, "run", std::string(PRODUCTS_DIR) + "/lego-tower/lego-tower.aml", "--cell",
                           (dir / "cell.yaml").string(), "--domain", domains::text(domains::kRunTwinFrozen), "--real-time-factor",
-                          "10", "--out",
-                          (dir / "out").string()},
+                          "10", "--out", (dir / "out").string()},
                          (dir / "run.log").string());
   REQUIRE(test::appears(dir / "run.log", "order lego-tower: twin pid "));
   const std::string started = read_text(dir / "run.log");
