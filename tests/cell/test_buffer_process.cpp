@@ -2,6 +2,7 @@
 // answered with command events, an empty buffer refusing, and its capability gone when it
 // stops. Bounded waits only; the process is always ended.
 
+#include <csignal>
 #include <unistd.h>
 
 #include <algorithm>
@@ -199,6 +200,40 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
   CHECK(seen.gone_now() == std::vector<std::string>{"buffer-2"});
   CHECK(bystander.stop() == 0);
   test::clean_stale_dds_segments();  // what the killed process left behind
+}
+
+// A process starved of CPU past its lease, not dead (stopped here): its readers take its state
+// for gone, and must have it back once it runs again, though it has nothing new to say. Fast
+// DDS brings a NOT_ALIVE instance back only with a new sample; the state writers write their
+// last samples again at a third of their lease (dds::Writer::refresh). Before that, a buffer
+// starved under TSan beside CPU hogs was never heard of again.
+TEST_CASE("buffer process stopped past its lease: gone, then its capability back once it runs again, said once",
+          "[process][buffer]") {
+  constexpr int domain = domains::kBufferStopped;
+  test::clean_stale_dds_segments();
+  test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-4", "--domain", std::to_string(domain), "--stock",
+                             "RoundPeg=2", "--lease", "0.5"});
+  Seen seen;
+  auto participant = dds::make_participant("test-twin", {domain, true, {}});
+  const auto capabilities = watch_capabilities(participant, seen);
+  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+
+  ::kill(buffer.pid(), SIGSTOP);
+  const bool gone = seen.wait([&] { return !seen.gone.empty(); });
+  ::kill(buffer.pid(), SIGCONT);
+  REQUIRE(gone);
+  CHECK(seen.first_gone() == "buffer-4");
+  REQUIRE(seen.wait([&] { return seen.capabilities.size() >= 2; }));
+  CHECK(seen.last_capability().resource_id() == "buffer-4");
+  CHECK(stock_of(seen.last_capability(), "RoundPeg") == 2);
+  // Its refreshes (every 0.17 s) are not news: in a second more, a capability comes only after
+  // an end (were it starved again).
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  {
+    std::lock_guard<std::mutex> lock(seen.mutex);
+    CHECK(seen.capabilities.size() == seen.gone.size() + 1);
+  }
+  CHECK(buffer.stop() == 0);
 }
 
 TEST_CASE("a buffer that restarts answers the command its process had taken on ABORTED, saying it restarted",
