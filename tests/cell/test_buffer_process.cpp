@@ -9,6 +9,7 @@
 #include <thread>
 #include <condition_variable>
 #include <filesystem>
+#include <iostream>
 #include <memory>
 #include <mutex>
 
@@ -221,9 +222,12 @@ TEST_CASE("buffer process stopped past its lease: gone, then its capability back
   ::kill(buffer.pid(), SIGSTOP);
   const bool gone = seen.wait([&] { return !seen.gone.empty(); });
   ::kill(buffer.pid(), SIGCONT);
+  const auto continued = std::chrono::steady_clock::now();
   REQUIRE(gone);
   CHECK(seen.first_gone() == "buffer-4");
   REQUIRE(seen.wait([&] { return seen.capabilities.size() >= 2; }));
+  const double back_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - continued).count();
+  std::cout << "capability back " << back_after << " s after the buffer ran again (lease 0.5 s)\n";
   CHECK(seen.last_capability().resource_id() == "buffer-4");
   CHECK(stock_of(seen.last_capability(), "RoundPeg") == 2);
   // Its refreshes (every 0.17 s) are not news: in a second more, a capability comes only after
