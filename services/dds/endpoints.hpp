@@ -157,19 +157,21 @@ class Writer : private fdds::DataWriterListener {
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
 
+  // State topics: the sample is kept for the next refresh before it is written (a reader's
+  // callback in this process may write here during the write), and kept even if the write
+  // fails: the refresh writes it then.
   bool write(const T& sample) {
     if (!kept_alive_) return writer_->write(const_cast<T*>(&sample));
     std::lock_guard<std::recursive_mutex> lock(last_mutex_);
-    if (!writer_->write(const_cast<T*>(&sample))) return false;
     last_.insert_or_assign(instance_of(sample), sample);
-    return true;
+    return writer_->write(const_cast<T*>(&sample));
   }
 
   // Keyed topics: the instance of `sample` ends here (late readers no longer get it).
   void unregister(const T& sample) {
     std::lock_guard<std::recursive_mutex> lock(last_mutex_);
-    writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL);
     last_.erase(instance_of(sample));
+    writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL);
   }
 
   // Until every matched reader acknowledged every sample written (at most `timeout`).
@@ -385,12 +387,19 @@ class Reader : private fdds::DataReaderListener {
     fdds::SampleInfoSeq infos;
     const auto visit = [&](auto&& each, bool as_alive = false) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        if (!infos[i].valid_data) continue;
+        if (!infos[i].valid_data) {
+          // An instance its writer unregistered (the end replaced its last sample): the same
+          // state written again later is news.
+          if (!as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) delivered_.erase(infos[i].instance_handle);
+          continue;
+        }
         // A binding that came during this drain: what waited for it goes first, in order.
         deliver_held_if_bound();
         const Source source{infos[i].sample_identity.writer_guid(), infos[i].instance_handle,
                             !as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
-        if (repeats(samples[i], source)) continue;
+        // A NEW view: the instance's first sample, or its first since it ended (its writer
+        // lapsed or unregistered it), whatever was delivered before.
+        if (infos[i].view_state != fdds::NEW_VIEW_STATE && repeats(samples[i], source)) continue;
         const Verdict v = from_its_owner(samples[i], source);
         if (v == Verdict::take) {
           remember(samples[i], source);
@@ -473,6 +482,15 @@ class Reader : private fdds::DataReaderListener {
   static constexpr std::chrono::seconds kHoldFor{5};
 
   void hold(const T& sample, const Source& from) {
+    if (kind_ == TopicKind::state && !from.gone) {  // a writer's refresh replaces the state it held last
+      const auto last = std::find_if(held_.rbegin(), held_.rend(), [&](const Held& h) {
+        return h.from.writer == from.writer && h.from.instance == from.instance;
+      });
+      if (last != held_.rend() && !last->from.gone) {
+        last->sample = sample;
+        return;
+      }
+    }
     if (held_.size() >= kHeld) {
       std::cerr << "dropped a sample on " << topic_ << " from writer " << held_.front().from.writer
                 << ": its order was bound to no twin, or to another, while " << kHeld << " more came\n";
@@ -499,6 +517,7 @@ class Reader : private fdds::DataReaderListener {
                   << "its writer within " << kHoldFor.count() << " s\n";
         continue;
       }
+      if (repeats(h.sample, h.from)) continue;
       const Verdict v = from_its_owner(h.sample, h.from);
       const auto& deliver = h.from.gone ? on_gone_ : on_sample_;
       if (v == Verdict::take) {

@@ -29,11 +29,11 @@ class LivelinessKeeper {
  public:
   static LivelinessKeeper& of_this_process();
 
-  // From now on, until forget(writer) returns, `assert_alive` is called every `period`.
-  // Neither keep nor forget may be called from a DDS callback: the keeper's thread may be the
-  // one delivering it (a reader in this process of a kept writer) and holds its lock.
+  // From now on, until forget(writer) returns, `assert_alive` is called every `period`, on
+  // the keeper's thread, one writer at a time.
   void keep(const void* writer, std::chrono::milliseconds period, std::function<void()> assert_alive);
-  // Once this returns, the keeper no longer calls `writer`'s assertion (it may be deleted).
+  // Once this returns, the keeper no longer calls `writer`'s assertion (it may be deleted),
+  // but from a callback on the keeper's thread during that very assertion.
   void forget(const void* writer);
 
   ~LivelinessKeeper();
@@ -50,6 +50,8 @@ class LivelinessKeeper {
   };
   std::mutex mutex_;
   std::condition_variable changed_;
+  std::condition_variable done_;  // an assertion ended
+  const void* asserting_ = nullptr;
   std::vector<Kept> kept_;
   bool stopping_ = false;
   std::thread thread_;

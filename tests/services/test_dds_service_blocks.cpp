@@ -112,7 +112,8 @@ TEST_CASE("state topics: a late reader sees the last state, and a dead writer is
 // A state writer writes its last samples again at a third of its lease (so that a reader that
 // took it for gone while it was starved has its state back, test_buffer_process.cpp): a reader
 // delivers a state once, again only when it changes.
-TEST_CASE("state topics: a state written again is delivered once, a changed one each time", "[dds]") {
+TEST_CASE("state topics: a state written again is delivered once, a changed one each time, an ended one again",
+          "[dds]") {
   const dds::ParticipantSettings settings{domains::kDdsRepeatedState, true, {}};
   auto twin = dds::make_participant("test-twin", settings);
   auto buffer = dds::make_participant("test-buffer", settings);
@@ -150,6 +151,11 @@ TEST_CASE("state topics: a state written again is delivered once, a changed one 
   capability.stock()[0].count(1);
   REQUIRE(writer.write(capability));
   CHECK(seen_after(std::chrono::seconds(10), 2) == std::vector<int>{2, 1});
+  // An instance that ended (unregistered: an identity given back to the pool) and is written
+  // again as it was is news (a twin's binding to the same order again).
+  writer.unregister(capability);
+  REQUIRE(writer.write(capability));
+  CHECK(seen_after(std::chrono::seconds(10), 3) == std::vector<int>{2, 1, 1});
 }
 
 TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers it all in order once it reads again",
