@@ -9,12 +9,10 @@
 #include <deque>
 #include <functional>
 #include <iostream>
-#include <map>
 #include <optional>
 #include <set>
 #include <type_traits>
 #include <utility>
-#include <vector>
 #include <malloc.h>
 #include <mutex>
 #include <stdexcept>
@@ -140,12 +138,12 @@ class Writer : private fdds::DataWriterListener {
     if (kind == TopicKind::state) {
       kept_alive_ = true;
       LivelinessKeeper::of_this_process().keep(
-          this, std::chrono::milliseconds(static_cast<long>(settings.liveliness_lease_s * 1000 / 3)), [this] { refresh(); });
+          writer_, std::chrono::milliseconds(static_cast<long>(settings.liveliness_lease_s * 1000 / 3)));
     }
   }
   // A matched callback already under way finishes first; later ones find the writer closed.
   ~Writer() override {
-    if (kept_alive_) LivelinessKeeper::of_this_process().forget(this);
+    if (kept_alive_) LivelinessKeeper::of_this_process().forget(writer_);
     writer_->set_listener(nullptr);
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -157,22 +155,10 @@ class Writer : private fdds::DataWriterListener {
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
 
-  // State topics: the sample is kept for the next refresh before it is written (a reader's
-  // callback in this process may write here during the write), and kept even if the write
-  // fails: the refresh writes it then.
-  bool write(const T& sample) {
-    if (!kept_alive_) return writer_->write(const_cast<T*>(&sample));
-    std::lock_guard<std::recursive_mutex> lock(last_mutex_);
-    last_.insert_or_assign(instance_of(sample), sample);
-    return writer_->write(const_cast<T*>(&sample));
-  }
+  bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
 
   // Keyed topics: the instance of `sample` ends here (late readers no longer get it).
-  void unregister(const T& sample) {
-    std::lock_guard<std::recursive_mutex> lock(last_mutex_);
-    last_.erase(instance_of(sample));
-    writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL);
-  }
+  void unregister(const T& sample) { writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL); }
 
   // Until every matched reader acknowledged every sample written (at most `timeout`).
   bool wait_for_acknowledgments(std::chrono::milliseconds timeout) {
@@ -200,31 +186,6 @@ class Writer : private fdds::DataWriterListener {
   }
 
  private:
-  // State topics, from the LivelinessKeeper: each instance's last sample written again, which
-  // asserts the writer's liveliness too. A reader that found the writer's liveliness lapsed
-  // (this process or the reader's starved past the lease, not dead) has its state back so;
-  // Fast DDS keeps the instances NOT_ALIVE until the next write. Readers let a repeated
-  // sample through only after its instance's end (Reader::repeats).
-  // A write delivers to this process's readers on the writing thread: their callbacks may
-  // write or unregister here meanwhile (hence a recursive lock, and each instance looked up
-  // afresh).
-  void refresh() {
-    std::lock_guard<std::recursive_mutex> lock(last_mutex_);
-    if (last_.empty()) writer_->assert_liveliness();
-    std::vector<fdds::InstanceHandle_t> instances;
-    for (const auto& kept : last_) instances.push_back(kept.first);
-    for (const auto& instance : instances) {
-      const auto it = last_.find(instance);
-      if (it != last_.end()) writer_->write(&it->second);
-    }
-  }
-
-  fdds::InstanceHandle_t instance_of(const T& sample) {
-    fdds::InstanceHandle_t handle;
-    if (key_type_.m_isGetKeyDefined) key_type_.getKey(const_cast<T*>(&sample), &handle, false);
-    return handle;
-  }
-
   void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closed_) return;
@@ -237,9 +198,6 @@ class Writer : private fdds::DataWriterListener {
   fdds::Publisher* publisher_ = nullptr;
   fdds::DataWriter* writer_ = nullptr;
   bool kept_alive_ = false;
-  std::recursive_mutex last_mutex_;  // a refresh never writes an instance's older sample after its newer one
-  PubSubType key_type_;
-  std::map<fdds::InstanceHandle_t, T> last_;  // state topics: each live instance's last sample
   std::mutex mutex_;
   std::condition_variable matched_changed_;
   int matched_ = 0;
@@ -375,9 +333,7 @@ class Reader : private fdds::DataReaderListener {
 
   // Event topics: take every new sample. State topics: read new samples but keep the last
   // one per instance, so that when an instance's writers are gone (its state turns
-  // NOT_ALIVE) the kept sample tells which instance it was; then take it. New samples are
-  // read whatever their instance's state: one that came just before its writer's liveliness
-  // lapsed is delivered before the instance's end, not lost in it. A read or take
+  // NOT_ALIVE) the kept sample tells which instance it was; then take it. A read or take
   // gives at most max_samples_per_read (32): each goes round until nothing is left, or what
   // came while another thread's callback was folded into this drain would wait for the next
   // sample (under TSan, the last of a burst's 9 834 command events waited for ever so).
@@ -385,26 +341,15 @@ class Reader : private fdds::DataReaderListener {
     deliver_held_if_bound();
     fdds::LoanableSequence<T> samples;
     fdds::SampleInfoSeq infos;
-    const auto visit = [&](auto&& each, bool as_alive = false) {
+    const auto visit = [&](auto&& each) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        if (!infos[i].valid_data) {
-          // An instance its writer unregistered (the end replaced its last sample): the same
-          // state written again later is news.
-          if (!as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) delivered_.erase(infos[i].instance_handle);
-          continue;
-        }
+        if (!infos[i].valid_data) continue;
         // A binding that came during this drain: what waited for it goes first, in order.
         deliver_held_if_bound();
         const Source source{infos[i].sample_identity.writer_guid(), infos[i].instance_handle,
-                            !as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
-        // A NEW view: the instance's first sample, or its first since it ended (its writer
-        // lapsed or unregistered it), whatever was delivered before.
-        if (infos[i].view_state != fdds::NEW_VIEW_STATE && repeats(samples[i], source)) continue;
+                            infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
         const Verdict v = from_its_owner(samples[i], source);
-        if (v == Verdict::take) {
-          remember(samples[i], source);
-          each(samples[i]);
-        }
+        if (v == Verdict::take) each(samples[i]);
         if (v == Verdict::hold) hold(samples[i], source);
       }
       reader->return_loan(samples, infos);
@@ -414,8 +359,9 @@ class Reader : private fdds::DataReaderListener {
       while (!closed_ && reader->take(samples, infos) == ok) visit([&](const T& s) { if (on_sample_) on_sample_(s); });
       return;
     }
-    while (!closed_ && reader->read(samples, infos, fdds::LENGTH_UNLIMITED, fdds::NOT_READ_SAMPLE_STATE) == ok) {
-      visit([&](const T& s) { if (on_sample_) on_sample_(s); }, /*as_alive=*/true);
+    while (!closed_ && reader->read(samples, infos, fdds::LENGTH_UNLIMITED, fdds::NOT_READ_SAMPLE_STATE,
+                                    fdds::ANY_VIEW_STATE, fdds::ALIVE_INSTANCE_STATE) == ok) {
+      visit([&](const T& s) { if (on_sample_) on_sample_(s); });
     }
     while (!closed_ && reader->take(samples, infos, fdds::LENGTH_UNLIMITED, fdds::ANY_SAMPLE_STATE, fdds::ANY_VIEW_STATE,
                                     fdds::NOT_ALIVE_INSTANCE_STATE) == ok) {
@@ -423,27 +369,12 @@ class Reader : private fdds::DataReaderListener {
     }
   }
 
-  using Guid = eprosima::fastrtps::rtps::GUID_t;
   enum class Verdict { take, drop, hold };
   struct Source {
-    Guid writer;
+    eprosima::fastrtps::rtps::GUID_t writer;
     fdds::InstanceHandle_t instance;
     bool gone;  // the instance's end (its writers gone, or disposed)
   };
-
-  // State topics: whether `sample` is what its writer last delivered of its instance (the
-  // writer's refresh, Writer::refresh). The same state from another writer is news: a process
-  // started anew says it is there, before its old self's lease has run out.
-  bool repeats(const T& sample, const Source& from) const {
-    if (kind_ != TopicKind::state || from.gone) return false;
-    const auto it = delivered_.find(from.instance);
-    return it != delivered_.end() && it->second.first == from.writer && it->second.second == sample;
-  }
-  void remember(const T& sample, const Source& from) {
-    if (kind_ != TopicKind::state) return;
-    if (from.gone) delivered_.erase(from.instance);
-    else delivered_.insert_or_assign(from.instance, std::make_pair(from.writer, sample));
-  }
 
   // Under DDS-Security a resource may write an owned topic (or one it speaks on for itself) in
   // its own partition only, a twin its order's topics in its own; a sample written for another
@@ -482,15 +413,6 @@ class Reader : private fdds::DataReaderListener {
   static constexpr std::chrono::seconds kHoldFor{5};
 
   void hold(const T& sample, const Source& from) {
-    if (kind_ == TopicKind::state && !from.gone) {  // a writer's refresh replaces the state it held last
-      const auto last = std::find_if(held_.rbegin(), held_.rend(), [&](const Held& h) {
-        return h.from.writer == from.writer && h.from.instance == from.instance;
-      });
-      if (last != held_.rend() && !last->from.gone) {
-        last->sample = sample;
-        return;
-      }
-    }
     if (held_.size() >= kHeld) {
       std::cerr << "dropped a sample on " << topic_ << " from writer " << held_.front().from.writer
                 << ": its order was bound to no twin, or to another, while " << kHeld << " more came\n";
@@ -517,13 +439,9 @@ class Reader : private fdds::DataReaderListener {
                   << "its writer within " << kHoldFor.count() << " s\n";
         continue;
       }
-      if (repeats(h.sample, h.from)) continue;
       const Verdict v = from_its_owner(h.sample, h.from);
       const auto& deliver = h.from.gone ? on_gone_ : on_sample_;
-      if (v == Verdict::take) {
-        remember(h.sample, h.from);
-        if (deliver) deliver(h.sample);
-      }
+      if (v == Verdict::take && deliver) deliver(h.sample);
       if (v == Verdict::hold) waiting.push_back(std::move(h));
     }
     held_ = std::move(waiting);
@@ -539,8 +457,6 @@ class Reader : private fdds::DataReaderListener {
   // State topics: the instances each writer spoke for with the right to, until their end.
   std::set<std::pair<eprosima::fastrtps::rtps::GUID_t, fdds::InstanceHandle_t>> trusted_;
   std::deque<Held> held_;
-  // State topics: each live instance's last delivered sample, and its writer.
-  std::map<fdds::InstanceHandle_t, std::pair<Guid, T>> delivered_;
   unsigned held_checked_at_ = 0;  // the bindings' generation the held samples were last checked at
   std::shared_ptr<TwinBindings> bindings_;
   int listener_ = -1;

@@ -109,55 +109,6 @@ TEST_CASE("state topics: a late reader sees the last state, and a dead writer is
   CHECK(fb::get<std::string>(recorder.events[1].data, "resource_id") == "buffer-1");
 }
 
-// A state writer writes its last samples again at a third of its lease (so that a reader that
-// took it for gone while it was starved has its state back, test_buffer_process.cpp): a reader
-// delivers a state once, again only when it changes.
-TEST_CASE("state topics: a state written again is delivered once, a changed one each time, an ended one again",
-          "[dds]") {
-  const dds::ParticipantSettings settings{domains::kDdsRepeatedState, true, {}};
-  auto twin = dds::make_participant("test-twin", settings);
-  auto buffer = dds::make_participant("test-buffer", settings);
-  dds::QosSettings quick;
-  quick.liveliness_lease_s = 0.3;  // written again every 0.1 s
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::vector<int> seen;  // the stock of each capability delivered
-  dds::Reader<cell::Capability, cell::CapabilityPubSubType> reader(
-      twin, "cell/capabilities", dds::TopicKind::state,
-      [&](const cell::Capability& c) {
-        std::lock_guard<std::mutex> lock(mutex);
-        seen.push_back(c.stock()[0].count());
-        changed.notify_all();
-      },
-      {}, quick);
-  const auto seen_after = [&](std::chrono::milliseconds wait, std::size_t count) {
-    std::unique_lock<std::mutex> lock(mutex);
-    changed.wait_for(lock, wait, [&] { return seen.size() >= count; });
-    return seen;
-  };
-  CapabilityWriter writer(buffer, "cell/capabilities", dds::TopicKind::state, quick);
-  cell::Capability capability;
-  capability.resource_id("buffer-1");
-  capability.kind("buffer");
-  capability.stock().push_back(cell::PartStock());
-  capability.stock()[0].part_type("SquarePeg");
-  capability.stock()[0].count(2);
-  REQUIRE(writer.wait_for_readers(1, std::chrono::seconds(10)));
-  REQUIRE(writer.write(capability));
-  REQUIRE(writer.write(capability));
-  CHECK(seen_after(std::chrono::seconds(10), 1) == std::vector<int>{2});
-  // Ten refreshes and more: nothing new is delivered.
-  CHECK(seen_after(std::chrono::milliseconds(1000), 2) == std::vector<int>{2});
-  capability.stock()[0].count(1);
-  REQUIRE(writer.write(capability));
-  CHECK(seen_after(std::chrono::seconds(10), 2) == std::vector<int>{2, 1});
-  // An instance that ended (unregistered: an identity given back to the pool) and is written
-  // again as it was is news (a twin's binding to the same order again).
-  writer.unregister(capability);
-  REQUIRE(writer.write(capability));
-  CHECK(seen_after(std::chrono::seconds(10), 3) == std::vector<int>{2, 1, 1});
-}
-
 TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers it all in order once it reads again",
           "[dds]") {
   // Between two participants of one process Fast DDS delivers on the writer's thread, into the

@@ -50,7 +50,6 @@ inline constexpr int kTwoDiscoveryServers = 206;
 inline constexpr int kCancelWhilePlanning = 207;
 inline constexpr int kTwoHostsServers = 208;
 inline constexpr int kUpPastAHostLimit = 209;
-inline constexpr int kDdsRepeatedState = 211;
 inline constexpr int kBufferStopped = 212;
 inline constexpr int kHostileOpening = 213;
 inline constexpr int kHostileHugePath = 214;
@@ -76,13 +75,14 @@ inline constexpr int kQuoteNoAnswer = 232;  // tests/cli/CMakeLists.txt, tests/d
 inline constexpr int kAll[] = {
     kOperatorTakesAStationOut, kDiscoveryServer, kDdsEvents, kCancel, kDashboardTakesOrders, kDashboardInBrowser,
     kDashboard, kTwinFrozenDesk, kRealBoxOffCentre, kRunTwinFrozen, kQuotesThrifty, kBufferProcess, kBufferKilled,
-    kBufferStopped, kBufferRestarts, kOrphanedProcess, kThreadedTable, kLegoTower, kCranfield, kBadOrderFailsAlone, kTwinAlone,
+    kBufferRestarts, kOrphanedProcess, kThreadedTable, kLegoTower, kCranfield, kBadOrderFailsAlone, kTwinAlone,
     kTwinBeforeTheCell, kResourceDies, kTwinDies, kTenMixedOrders, kTenQueuedOrders, kKillsMidOrder, kChaos,
-    kTwinResumes, kDownPauses, kDdsStateTopics, kDdsRepeatedState, kDdsOutbox, kStandbyTwin, kSubassemblyResumed, kNutOnBolt,
+    kTwinResumes, kDownPauses, kDdsStateTopics, kDdsOutbox, kStandbyTwin, kSubassemblyResumed, kNutOnBolt,
     kUpsideDownTable, kQuoteAccuracyA, kTwoDiscoveryServers, kCancelWhilePlanning, kTwoHostsServers, kUpPastAHostLimit,
     kHostileOpening, kHostileHugePath, kHostileUnhiredFetch, kHostileUnawardedGive, kHostileIntruderCommand,
     kHostileIntruderSim, kHostileBurst, kUpRestarts, kOneCellPerDomain, kQuoteAccuracyB, kSecureDashboard, kPki,
-    kSecureCell, kOrderDesk, kTwoHosts, kQuotesFast, kSixtyOrders, kUpHung, kOrderQueue, kQuoteNoAnswer};
+    kSecureCell, kOrderDesk, kTwoHosts, kQuotesFast, kSixtyOrders, kUpHung, kOrderQueue, kQuoteNoAnswer,
+    kBufferStopped};
 
 constexpr bool all_differ() {
   for (const int a : kAll) {
