@@ -12,6 +12,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #define CATCH_CONFIG_RUNNER
@@ -50,7 +51,7 @@ class TwoHosts {
           sh("ip -n " + n.oem_ns + " addr add " + n.oem_ip + "/24 dev " + n.oem_if) == 0 &&
           sh("ip -n " + n.cell_ns + " link set " + n.cell_if + " up") == 0 &&
           sh("ip -n " + n.oem_ns + " link set " + n.oem_if + " up") == 0 && sh("ip -n " + n.cell_ns + " link set lo up") == 0 &&
-          sh("ip -n " + n.oem_ns + " link set lo up") == 0;
+          sh("ip -n " + n.oem_ns + " link set lo up") == 0 && running(n.cell_ns, n.cell_if) && running(n.oem_ns, n.oem_if);
   }
   ~TwoHosts() {
     for (const auto& ns : {net_.cell_ns, net_.oem_ns}) {
@@ -62,6 +63,18 @@ class TwoHosts {
   const Net& net() const { return net_; }
 
  private:
+  // Until the link carries (its carrier up, which the kernel reports a while after `link set
+  // up`), at most 10 s. Fast DDS takes only RUNNING interfaces: a discovery server started on a
+  // veth not yet so found "all whitelist interfaces filtered out" and exited (a CI rehearsal).
+  static bool running(const std::string& ns, const std::string& interface) {
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (sh("ip -n " + ns + " link show dev " + interface + " | grep -q 'LOWER_UP.*state UP'") != 0) {
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      std::this_thread::sleep_for(20ms);
+    }
+    return true;
+  }
+
   Net net_;
   bool ok_ = false;
 };
