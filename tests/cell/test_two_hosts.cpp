@@ -98,8 +98,9 @@ TEST_CASE("two hosts: an OEM in one network namespace submits Cranfield to a sec
                          "--real-time-factor", "50", "--state-dir", (dir / "state").string()},
                         (dir / "up.log").string());
   {
-    INFO(test::read_text(dir / "up.log"));
-    REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+    const bool up_now = test::appears(dir / "up.log", "cell up on domain", 60s);
+    INFO(test::read_text(dir / "up.log"));  // after the wait: what up said by then
+    REQUIRE(up_now);
   }
   // The OEM has its own folder: the CA's certificate, the governance and its identity only.
   const fs::path oem = dir / "oem-a";
@@ -147,8 +148,9 @@ TEST_CASE("two hosts: a discovery server on each; the OEM host's server killed w
   server_argv.insert(server_argv.end(), servers.begin(), servers.end());
   test::ChildProcess oem_server(server_argv, (dir / "oem-server.log").string());
   {
-    INFO(test::read_text(dir / "up.log"));
-    REQUIRE(test::appears(dir / "up.log", "cell up on domain", 60s));
+    const bool up_now = test::appears(dir / "up.log", "cell up on domain", 60s);
+    INFO(test::read_text(dir / "up.log"));  // after the wait: what up said by then
+    REQUIRE(up_now);
   }
   const auto submit = [&](const std::string& id) {
     std::vector<std::string> argv{"/usr/sbin/ip", "netns", "exec", n.oem_ns, CELLCTL_EXE, "submit",
