@@ -9,10 +9,12 @@
 #include <deque>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <set>
 #include <type_traits>
 #include <utility>
+#include <vector>
 #include <malloc.h>
 #include <mutex>
 #include <stdexcept>
@@ -138,12 +140,12 @@ class Writer : private fdds::DataWriterListener {
     if (kind == TopicKind::state) {
       kept_alive_ = true;
       LivelinessKeeper::of_this_process().keep(
-          writer_, std::chrono::milliseconds(static_cast<long>(settings.liveliness_lease_s * 1000 / 3)));
+          this, std::chrono::milliseconds(static_cast<long>(settings.liveliness_lease_s * 1000 / 3)), [this] { refresh(); });
     }
   }
   // A matched callback already under way finishes first; later ones find the writer closed.
   ~Writer() override {
-    if (kept_alive_) LivelinessKeeper::of_this_process().forget(writer_);
+    if (kept_alive_) LivelinessKeeper::of_this_process().forget(this);
     writer_->set_listener(nullptr);
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -155,10 +157,22 @@ class Writer : private fdds::DataWriterListener {
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
 
-  bool write(const T& sample) { return writer_->write(const_cast<T*>(&sample)); }
+  // State topics: the sample is kept for the next refresh before it is written (a reader's
+  // callback in this process may write here during the write), and kept even if the write
+  // fails: the refresh writes it then.
+  bool write(const T& sample) {
+    if (!kept_alive_) return writer_->write(const_cast<T*>(&sample));
+    std::lock_guard<std::recursive_mutex> lock(last_mutex_);
+    last_.insert_or_assign(instance_of(sample), sample);
+    return writer_->write(const_cast<T*>(&sample));
+  }
 
   // Keyed topics: the instance of `sample` ends here (late readers no longer get it).
-  void unregister(const T& sample) { writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL); }
+  void unregister(const T& sample) {
+    std::lock_guard<std::recursive_mutex> lock(last_mutex_);
+    last_.erase(instance_of(sample));
+    writer_->unregister_instance(const_cast<T*>(&sample), fdds::HANDLE_NIL);
+  }
 
   // Until every matched reader acknowledged every sample written (at most `timeout`).
   bool wait_for_acknowledgments(std::chrono::milliseconds timeout) {
@@ -186,6 +200,31 @@ class Writer : private fdds::DataWriterListener {
   }
 
  private:
+  // State topics, from the LivelinessKeeper: each instance's last sample written again, which
+  // asserts the writer's liveliness too. A reader that found the writer's liveliness lapsed
+  // (this process or the reader's starved past the lease, not dead) has its state back so;
+  // Fast DDS keeps the instances NOT_ALIVE until the next write. Readers let a repeated
+  // sample through only after its instance's end (Reader::repeats).
+  // A write delivers to this process's readers on the writing thread: their callbacks may
+  // write or unregister here meanwhile (hence a recursive lock, and each instance looked up
+  // afresh).
+  void refresh() {
+    std::lock_guard<std::recursive_mutex> lock(last_mutex_);
+    if (last_.empty()) writer_->assert_liveliness();
+    std::vector<fdds::InstanceHandle_t> instances;
+    for (const auto& kept : last_) instances.push_back(kept.first);
+    for (const auto& instance : instances) {
+      const auto it = last_.find(instance);
+      if (it != last_.end()) writer_->write(&it->second);
+    }
+  }
+
+  fdds::InstanceHandle_t instance_of(const T& sample) {
+    fdds::InstanceHandle_t handle;
+    if (key_type_.m_isGetKeyDefined) key_type_.getKey(const_cast<T*>(&sample), &handle, false);
+    return handle;
+  }
+
   void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closed_) return;
@@ -198,6 +237,9 @@ class Writer : private fdds::DataWriterListener {
   fdds::Publisher* publisher_ = nullptr;
   fdds::DataWriter* writer_ = nullptr;
   bool kept_alive_ = false;
+  std::recursive_mutex last_mutex_;  // a refresh never writes an instance's older sample after its newer one
+  PubSubType key_type_;
+  std::map<fdds::InstanceHandle_t, T> last_;  // state topics: each live instance's last sample
   std::mutex mutex_;
   std::condition_variable matched_changed_;
   int matched_ = 0;
@@ -311,10 +353,16 @@ class Reader : private fdds::DataReaderListener {
   // A writer that leaves or dies changes its instances' state; Fast DDS 2.9 does not always
   // announce that through on_data_available, so look then too.
   void on_subscription_matched(fdds::DataReader* reader, const fdds::SubscriptionMatchedStatus& status) override {
-    if (status.current_count_change < 0) drain(reader);
+    if (status.current_count_change < 0) announce_ends(reader);
   }
-  void on_liveliness_changed(fdds::DataReader* reader, const fdds::LivelinessChangedStatus& status) override {
-    if (status.not_alive_count_change > 0) drain(reader);
+  // Any change: Fast DDS 2.9.1 may merge a lapse into a concurrent update of the status.
+  void on_liveliness_changed(fdds::DataReader* reader, const fdds::LivelinessChangedStatus&) override {
+    announce_ends(reader);
+  }
+  // Instances whose sample was read may have ended without a sample: the drain looks at them.
+  void announce_ends(fdds::DataReader* reader) {
+    ends_announced_ = true;
+    drain(reader);
   }
 
   // Callbacks come on several Fast DDS threads, some holding the reader's own lock (data)
@@ -333,23 +381,40 @@ class Reader : private fdds::DataReaderListener {
 
   // Event topics: take every new sample. State topics: read new samples but keep the last
   // one per instance, so that when an instance's writers are gone (its state turns
-  // NOT_ALIVE) the kept sample tells which instance it was; then take it. A read or take
-  // gives at most max_samples_per_read (32): each goes round until nothing is left, or what
-  // came while another thread's callback was folded into this drain would wait for the next
-  // sample (under TSan, the last of a burst's 9 834 command events waited for ever so).
+  // NOT_ALIVE) the kept sample tells which instance it was. New samples are read whatever
+  // their instance's state: one that came just before its writer's liveliness lapsed is
+  // delivered before the instance's end, not lost in it. A read or take gives at most
+  // max_samples_per_read (32): each goes round until nothing is left, or what came while
+  // another thread's callback was folded into this drain would wait for the next sample
+  // (under TSan, the last of a burst's 9 834 command events waited for ever so).
   void drain_once(fdds::DataReader* reader) {
     deliver_held_if_bound();
     fdds::LoanableSequence<T> samples;
     fdds::SampleInfoSeq infos;
-    const auto visit = [&](auto&& each) {
+    bool ended = ends_announced_.exchange(false);  // a writer lapsed or left
+    const auto visit = [&](auto&& each, bool as_alive = false) {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        if (!infos[i].valid_data) continue;
+        if (infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) ended = true;
+        if (!infos[i].valid_data) {
+          // An instance its writer unregistered (the end replaced its last sample): the same
+          // state written again later is news.
+          if (!as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) delivered_.erase(infos[i].instance_handle);
+          continue;
+        }
+        // A new sample: its instance lived again since the end last said of it.
+        if (as_alive) ended_.erase(infos[i].instance_handle);
         // A binding that came during this drain: what waited for it goes first, in order.
         deliver_held_if_bound();
         const Source source{infos[i].sample_identity.writer_guid(), infos[i].instance_handle,
-                            infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
+                            !as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
+        // A NEW view: the instance's first sample, or its first since it ended (its writer
+        // lapsed or unregistered it), whatever was delivered before.
+        if (infos[i].view_state != fdds::NEW_VIEW_STATE && repeats(samples[i], source)) continue;
         const Verdict v = from_its_owner(samples[i], source);
-        if (v == Verdict::take) each(samples[i]);
+        if (v == Verdict::take) {
+          remember(samples[i], source);
+          each(samples[i]);
+        }
         if (v == Verdict::hold) hold(samples[i], source);
       }
       reader->return_loan(samples, infos);
@@ -359,22 +424,83 @@ class Reader : private fdds::DataReaderListener {
       while (!closed_ && reader->take(samples, infos) == ok) visit([&](const T& s) { if (on_sample_) on_sample_(s); });
       return;
     }
-    while (!closed_ && reader->read(samples, infos, fdds::LENGTH_UNLIMITED, fdds::NOT_READ_SAMPLE_STATE,
-                                    fdds::ANY_VIEW_STATE, fdds::ALIVE_INSTANCE_STATE) == ok) {
-      visit([&](const T& s) { if (on_sample_) on_sample_(s); });
+    while (!closed_ && reader->read(samples, infos, fdds::LENGTH_UNLIMITED, fdds::NOT_READ_SAMPLE_STATE) == ok) {
+      visit([&](const T& s) { if (on_sample_) on_sample_(s); }, /*as_alive=*/true);
     }
-    while (!closed_ && reader->take(samples, infos, fdds::LENGTH_UNLIMITED, fdds::ANY_SAMPLE_STATE, fdds::ANY_VIEW_STATE,
-                                    fdds::NOT_ALIVE_INSTANCE_STATE) == ok) {
+    // A topic without a key has one instance, which Fast DDS never erases: its end is taken.
+    if (!keyed_) {
+      while (!closed_ && reader->take(samples, infos, fdds::LENGTH_UNLIMITED, fdds::ANY_SAMPLE_STATE, fdds::ANY_VIEW_STATE,
+                                      fdds::NOT_ALIVE_INSTANCE_STATE) == ok) {
+        visit([&](const T& s) { if (on_gone_) on_gone_(s); });
+      }
+      return;
+    }
+    // Each ended instance's end, said once; the instance is read, not taken (sweep_ended).
+    // Looked for when something ended, and at each sweep in case an announcement was lost.
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= next_sweep_) ended = true;
+    fdds::InstanceHandle_t previous = fdds::HANDLE_NIL;
+    while (ended && !closed_ && reader->read_next_instance(samples, infos, fdds::LENGTH_UNLIMITED, previous, fdds::ANY_SAMPLE_STATE,
+                                                  fdds::ANY_VIEW_STATE, fdds::NOT_ALIVE_INSTANCE_STATE) == ok) {
+      previous = infos[0].instance_handle;
+      if (!ended_.emplace(previous, now).second) {
+        reader->return_loan(samples, infos);
+        continue;
+      }
       visit([&](const T& s) { if (on_gone_) on_gone_(s); });
+    }
+    if (!closed_) sweep_ended(reader, now);
+  }
+
+  // Why ended instances are taken in a sweep, not as their end is said: Fast DDS 2.9.1 walks
+  // a reader's instance map without the reader's lock when a writer lapses or leaves
+  // (DataReaderHistory::writer_not_alive; locked upstream in 2.14.6), and a take that empties
+  // an ended instance erases it from that map: the likeliest cause of a buffer that died in
+  // std::_Rb_tree_increment (docs/performance.md, "Ended instances swept"). Sweeps are seconds
+  // apart, and an instance whose writer only lapsed (its process starved) is back, as NEW,
+  // with its writer's next refresh before it is old enough to be swept: no erase and insert.
+  static constexpr std::chrono::seconds kEndedKept{10};
+  static constexpr std::chrono::seconds kSweepEvery{5};
+  void sweep_ended(fdds::DataReader* reader, std::chrono::steady_clock::time_point now) {
+    if (now < next_sweep_) return;
+    next_sweep_ = now + kSweepEvery;
+    fdds::LoanableSequence<T> samples;
+    fdds::SampleInfoSeq infos;
+    for (auto it = ended_.begin(); it != ended_.end();) {
+      if (now - it->second < kEndedKept) {
+        ++it;
+        continue;
+      }
+      // Only what was read: a sample that came since (the instance reborn) stays for the next drain.
+      if (reader->take_instance(samples, infos, fdds::LENGTH_UNLIMITED, it->first, fdds::READ_SAMPLE_STATE,
+                                fdds::ANY_VIEW_STATE, fdds::NOT_ALIVE_INSTANCE_STATE) == ReturnCode_t::RETCODE_OK) {
+        reader->return_loan(samples, infos);
+      }
+      it = ended_.erase(it);
     }
   }
 
+  using Guid = eprosima::fastrtps::rtps::GUID_t;
   enum class Verdict { take, drop, hold };
   struct Source {
-    eprosima::fastrtps::rtps::GUID_t writer;
+    Guid writer;
     fdds::InstanceHandle_t instance;
     bool gone;  // the instance's end (its writers gone, or disposed)
   };
+
+  // State topics: whether `sample` is what its writer last delivered of its instance (the
+  // writer's refresh, Writer::refresh). The same state from another writer is news: a process
+  // started anew says it is there, before its old self's lease has run out.
+  bool repeats(const T& sample, const Source& from) const {
+    if (kind_ != TopicKind::state || from.gone) return false;
+    const auto it = delivered_.find(from.instance);
+    return it != delivered_.end() && it->second.first == from.writer && it->second.second == sample;
+  }
+  void remember(const T& sample, const Source& from) {
+    if (kind_ != TopicKind::state) return;
+    if (from.gone) delivered_.erase(from.instance);
+    else delivered_.insert_or_assign(from.instance, std::make_pair(from.writer, sample));
+  }
 
   // Under DDS-Security a resource may write an owned topic (or one it speaks on for itself) in
   // its own partition only, a twin its order's topics in its own; a sample written for another
@@ -413,6 +539,15 @@ class Reader : private fdds::DataReaderListener {
   static constexpr std::chrono::seconds kHoldFor{5};
 
   void hold(const T& sample, const Source& from) {
+    if (kind_ == TopicKind::state && !from.gone) {  // a writer's refresh replaces the state it held last
+      const auto last = std::find_if(held_.rbegin(), held_.rend(), [&](const Held& h) {
+        return h.from.writer == from.writer && h.from.instance == from.instance;
+      });
+      if (last != held_.rend() && !last->from.gone) {
+        last->sample = sample;
+        return;
+      }
+    }
     if (held_.size() >= kHeld) {
       std::cerr << "dropped a sample on " << topic_ << " from writer " << held_.front().from.writer
                 << ": its order was bound to no twin, or to another, while " << kHeld << " more came\n";
@@ -439,9 +574,13 @@ class Reader : private fdds::DataReaderListener {
                   << "its writer within " << kHoldFor.count() << " s\n";
         continue;
       }
+      if (repeats(h.sample, h.from)) continue;
       const Verdict v = from_its_owner(h.sample, h.from);
       const auto& deliver = h.from.gone ? on_gone_ : on_sample_;
-      if (v == Verdict::take && deliver) deliver(h.sample);
+      if (v == Verdict::take) {
+        remember(h.sample, h.from);
+        if (deliver) deliver(h.sample);
+      }
       if (v == Verdict::hold) waiting.push_back(std::move(h));
     }
     held_ = std::move(waiting);
@@ -457,12 +596,19 @@ class Reader : private fdds::DataReaderListener {
   // State topics: the instances each writer spoke for with the right to, until their end.
   std::set<std::pair<eprosima::fastrtps::rtps::GUID_t, fdds::InstanceHandle_t>> trusted_;
   std::deque<Held> held_;
+  // State topics: each live instance's last delivered sample, and its writer.
+  std::map<fdds::InstanceHandle_t, std::pair<Guid, T>> delivered_;
+  // State topics: the ended instances whose end was said, since when; and the next sweep.
+  std::map<fdds::InstanceHandle_t, std::chrono::steady_clock::time_point> ended_;
+  std::chrono::steady_clock::time_point next_sweep_{};
   unsigned held_checked_at_ = 0;  // the bindings' generation the held samples were last checked at
   std::shared_ptr<TwinBindings> bindings_;
   int listener_ = -1;
   std::function<void(const T&)> on_sample_;
   std::function<void(const T&)> on_gone_;
   std::atomic<int> requests_{0};  // drain calls not yet served
+  std::atomic<bool> ends_announced_{false};
+  const bool keyed_ = PubSubType().m_isGetKeyDefined;
   std::atomic<bool> closed_{false};
   fdds::Subscriber* subscriber_ = nullptr;
   fdds::DataReader* reader_ = nullptr;

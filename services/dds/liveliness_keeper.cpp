@@ -1,8 +1,8 @@
 #include "services/dds/liveliness_keeper.hpp"
 
 #include <algorithm>
-
-#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <exception>
+#include <iostream>
 
 namespace dds {
 
@@ -11,18 +11,21 @@ LivelinessKeeper& LivelinessKeeper::of_this_process() {
   return keeper;
 }
 
-void LivelinessKeeper::keep(eprosima::fastdds::dds::DataWriter* writer, std::chrono::milliseconds period) {
+void LivelinessKeeper::keep(const void* writer, std::chrono::milliseconds period, std::function<void()> assert_alive) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!thread_.joinable()) thread_ = std::thread([this] { run(); });  // first: if it throws, nothing is kept
   period = std::max(period, std::chrono::milliseconds(1));
-  kept_.push_back({writer, period, std::chrono::steady_clock::now() + period});
+  kept_.push_back({writer, period, std::move(assert_alive), std::chrono::steady_clock::now() + period});
   changed_.notify_all();
 }
 
-void LivelinessKeeper::forget(eprosima::fastdds::dds::DataWriter* writer) {
-  std::lock_guard<std::mutex> lock(mutex_);  // an assertion under way ends first: it holds the lock
+void LivelinessKeeper::forget(const void* writer) {
+  std::unique_lock<std::mutex> lock(mutex_);
   kept_.erase(std::remove_if(kept_.begin(), kept_.end(), [writer](const Kept& k) { return k.writer == writer; }),
               kept_.end());
+  // An assertion of it under way ends first, unless it is this thread's (a reader's callback
+  // during it: waiting would never end).
+  if (std::this_thread::get_id() != thread_.get_id()) done_.wait(lock, [&] { return asserting_ != writer; });
 }
 
 LivelinessKeeper::~LivelinessKeeper() {
@@ -34,21 +37,29 @@ LivelinessKeeper::~LivelinessKeeper() {
   if (thread_.joinable()) thread_.join();
 }
 
+// One assertion at a time, with the lock released: it delivers to this process's readers on
+// this thread, and their callbacks may create or delete state writers (keep, forget).
 void LivelinessKeeper::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stopping_) {
     const auto now = std::chrono::steady_clock::now();
-    auto next = now + std::chrono::hours(1);
-    for (Kept& k : kept_) {
-      if (k.next <= now) {
-        // A heartbeat to its readers; to a reader in this process it is delivered on this
-        // thread, whose callbacks may run here (hence keep and forget never from a callback).
-        k.writer->assert_liveliness();
-        k.next = now + k.period;
-      }
-      next = std::min(next, k.next);
+    const auto due = std::min_element(kept_.begin(), kept_.end(), [](const Kept& a, const Kept& b) { return a.next < b.next; });
+    if (due == kept_.end() || due->next > now) {
+      changed_.wait_until(lock, due == kept_.end() ? now + std::chrono::hours(1) : due->next);
+      continue;
     }
-    changed_.wait_until(lock, next);
+    due->next = now + due->period;
+    asserting_ = due->writer;
+    const std::function<void()> assert_alive = due->assert_alive;
+    lock.unlock();
+    try {
+      assert_alive();
+    } catch (const std::exception& e) {
+      std::cerr << "could not assert a state writer's liveliness: " << e.what() << "\n";
+    }
+    lock.lock();
+    asserting_ = nullptr;
+    done_.notify_all();
   }
 }
 

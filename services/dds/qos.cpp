@@ -23,7 +23,8 @@ void apply(Qos& qos, TopicKind kind, const QosSettings& settings) {
     qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = KEEP_LAST_HISTORY_QOS;
     qos.history().depth = 1;
-    // Asserted per writer by the LivelinessKeeper (liveliness_keeper.hpp says why not AUTOMATIC).
+    // Asserted per writer by the LivelinessKeeper (liveliness_keeper.hpp says why not AUTOMATIC,
+    // and why by writing the last samples again).
     qos.liveliness().kind = MANUAL_BY_TOPIC_LIVELINESS_QOS;
     qos.liveliness().lease_duration = eprosima::fastrtps::Duration_t(settings.liveliness_lease_s);
   } else {

@@ -11,6 +11,7 @@
 
 #include "capabilitiesPubSubTypes.h"
 #include "commandsPubSubTypes.h"
+#include "simulationPubSubTypes.h"
 #include "services/dds/service_blocks.hpp"
 #include "services/runtime/block_test_fixture.hpp"
 #include "tests/support/domains.hpp"
@@ -107,6 +108,127 @@ TEST_CASE("state topics: a late reader sees the last state, and a dead writer is
   REQUIRE(run_until(resource, recorder, 2));
   CHECK(recorder.events[1].name == "GONE");
   CHECK(fb::get<std::string>(recorder.events[1].data, "resource_id") == "buffer-1");
+}
+
+// A reader reads an ended instance rather than take it (Reader::sweep_ended says why): its end
+// must still be said once, however many samples of other instances come after; and a topic
+// without a key (cell-sim's clock) has its end said too. A first version of the sweep read
+// the keyless topic's one instance for ever: `cellctl up` never finished its teardown.
+TEST_CASE("state topics: an end is said once while other states come, a keyless topic's too", "[dds]") {
+  const dds::ParticipantSettings settings{domains::kDdsEndSaidOnce, true, {}};
+  auto twin = dds::make_participant("test-twin", settings);
+  auto buffers = dds::make_participant("test-buffers", settings);
+  dds::QosSettings quick;
+  quick.liveliness_lease_s = 0.5;
+  std::mutex mutex;
+  std::condition_variable changed;
+  int heard = 0;
+  std::vector<std::string> gone;
+  const auto wait_until = [&](auto&& done) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return changed.wait_for(lock, std::chrono::seconds(10), done);
+  };
+  {
+    dds::Reader<cell::Capability, cell::CapabilityPubSubType> reader(
+        twin, "cell/capabilities", dds::TopicKind::state,
+        [&](const cell::Capability&) {
+          std::lock_guard<std::mutex> lock(mutex);
+          ++heard;
+          changed.notify_all();
+        },
+        [&](const cell::Capability& c) {
+          std::lock_guard<std::mutex> lock(mutex);
+          gone.push_back(c.resource_id().to_string());
+          changed.notify_all();
+        },
+        quick);
+    auto leaving = std::make_unique<CapabilityWriter>(buffers, "cell/capabilities", dds::TopicKind::state, quick);
+    CapabilityWriter staying(buffers, "cell/capabilities", dds::TopicKind::state, quick);
+    cell::Capability capability;
+    capability.resource_id("buffer-1");
+    REQUIRE(leaving->write(capability));
+    capability.resource_id("buffer-2");
+    capability.queued_commands(0);
+    REQUIRE(staying.write(capability));
+    REQUIRE(wait_until([&] { return heard == 2; }));
+    leaving.reset();
+    REQUIRE(wait_until([&] { return !gone.empty(); }));
+    for (int i = 1; i <= 20; ++i) {  // one at a time: a state reader keeps the last of each instance
+      capability.queued_commands(i);
+      REQUIRE(staying.write(capability));
+      REQUIRE(wait_until([&] { return heard == 2 + i; }));
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    CHECK(gone == std::vector<std::string>{"buffer-1"});
+  }
+  int clock_gone = 0;
+  dds::Reader<cell::Clock, cell::ClockPubSubType> clocks(
+      twin, "sim/clock", dds::TopicKind::state, [](const cell::Clock&) {},
+      [&](const cell::Clock&) {
+        std::lock_guard<std::mutex> lock(mutex);
+        ++clock_gone;
+        changed.notify_all();
+      },
+      quick);
+  {
+    dds::Writer<cell::Clock, cell::ClockPubSubType> clock(buffers, "sim/clock", dds::TopicKind::state, quick);
+    REQUIRE(clock.wait_for_readers(1, std::chrono::seconds(10)));
+    REQUIRE(clock.write(cell::Clock()));
+    REQUIRE(clock.wait_for_acknowledgments(std::chrono::seconds(10)));
+  }
+  REQUIRE(wait_until([&] { return clock_gone > 0; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  std::lock_guard<std::mutex> lock(mutex);
+  CHECK(clock_gone == 1);
+}
+
+// A state writer writes its last samples again at a third of its lease (so that a reader that
+// took it for gone while it was starved has its state back, test_buffer_process.cpp): a reader
+// delivers a state once, again only when it changes.
+TEST_CASE("state topics: a state written again is delivered once, a changed one each time, an ended one again",
+          "[dds]") {
+  const dds::ParticipantSettings settings{domains::kDdsRepeatedState, true, {}};
+  auto twin = dds::make_participant("test-twin", settings);
+  auto buffer = dds::make_participant("test-buffer", settings);
+  dds::QosSettings quick;
+  quick.liveliness_lease_s = 0.3;  // written again every 0.1 s
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::vector<int> seen;  // the stock of each capability delivered
+  dds::Reader<cell::Capability, cell::CapabilityPubSubType> reader(
+      twin, "cell/capabilities", dds::TopicKind::state,
+      [&](const cell::Capability& c) {
+        std::lock_guard<std::mutex> lock(mutex);
+        seen.push_back(c.stock()[0].count());
+        changed.notify_all();
+      },
+      {}, quick);
+  const auto seen_after = [&](std::chrono::milliseconds wait, std::size_t count) {
+    std::unique_lock<std::mutex> lock(mutex);
+    changed.wait_for(lock, wait, [&] { return seen.size() >= count; });
+    return seen;
+  };
+  CapabilityWriter writer(buffer, "cell/capabilities", dds::TopicKind::state, quick);
+  cell::Capability capability;
+  capability.resource_id("buffer-1");
+  capability.kind("buffer");
+  capability.stock().push_back(cell::PartStock());
+  capability.stock()[0].part_type("SquarePeg");
+  capability.stock()[0].count(2);
+  REQUIRE(writer.wait_for_readers(1, std::chrono::seconds(10)));
+  REQUIRE(writer.write(capability));
+  REQUIRE(writer.write(capability));
+  CHECK(seen_after(std::chrono::seconds(10), 1) == std::vector<int>{2});
+  // Ten refreshes and more: nothing new is delivered.
+  CHECK(seen_after(std::chrono::milliseconds(1000), 2) == std::vector<int>{2});
+  capability.stock()[0].count(1);
+  REQUIRE(writer.write(capability));
+  CHECK(seen_after(std::chrono::seconds(10), 2) == std::vector<int>{2, 1});
+  // An instance that ended (unregistered: an identity given back to the pool) and is written
+  // again as it was is news (a twin's binding to the same order again).
+  writer.unregister(capability);
+  REQUIRE(writer.write(capability));
+  CHECK(seen_after(std::chrono::seconds(10), 3) == std::vector<int>{2, 1, 1});
 }
 
 TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers it all in order once it reads again",

@@ -10,6 +10,7 @@
 
 namespace test::domains {
 
+inline constexpr int kDdsEndSaidOnce = 168;
 inline constexpr int kOperatorTakesAStationOut = 169;
 inline constexpr int kDiscoveryServer = 170;
 inline constexpr int kDdsEvents = 171;
@@ -39,6 +40,7 @@ inline constexpr int kKillsMidOrder = 195;
 inline constexpr int kChaos = 196;
 inline constexpr int kTwinResumes = 197;
 inline constexpr int kDownPauses = 198;
+inline constexpr int kDdsRepeatedState = 211;
 inline constexpr int kDdsStateTopics = 199;
 inline constexpr int kDdsOutbox = 200;
 inline constexpr int kStandbyTwin = 201;
@@ -77,7 +79,7 @@ inline constexpr int kAll[] = {
     kDashboard, kTwinFrozenDesk, kRealBoxOffCentre, kRunTwinFrozen, kQuotesThrifty, kBufferProcess, kBufferKilled,
     kBufferRestarts, kOrphanedProcess, kThreadedTable, kLegoTower, kCranfield, kBadOrderFailsAlone, kTwinAlone,
     kTwinBeforeTheCell, kResourceDies, kTwinDies, kTenMixedOrders, kTenQueuedOrders, kKillsMidOrder, kChaos,
-    kTwinResumes, kDownPauses, kDdsStateTopics, kDdsOutbox, kStandbyTwin, kSubassemblyResumed, kNutOnBolt,
+    kTwinResumes, kDownPauses, kDdsStateTopics, kDdsRepeatedState, kDdsEndSaidOnce, kDdsOutbox, kStandbyTwin, kSubassemblyResumed, kNutOnBolt,
     kUpsideDownTable, kQuoteAccuracyA, kTwoDiscoveryServers, kCancelWhilePlanning, kTwoHostsServers, kUpPastAHostLimit,
     kHostileOpening, kHostileHugePath, kHostileUnhiredFetch, kHostileUnawardedGive, kHostileIntruderCommand,
     kHostileIntruderSim, kHostileBurst, kUpRestarts, kOneCellPerDomain, kQuoteAccuracyB, kSecureDashboard, kPki,
