@@ -76,17 +76,17 @@ void OrderDesk::tend() {
     // twin that took it fails it itself, through the cleanup of any failure.
     if (!o.cancelled_by.empty() && o.attempts == 0) {
       const std::string why = "cancelled by " + o.cancelled_by + " before it started";
-      store_.set_order(id, "FAILED", why, 1);
-      store_.journal("cellctl", "cancelled", id, why);
+      store_.set_order(id, "FAILED", why, 1, {"cellctl", "cancelled", why});
       log_("order " + id + " " + why);
       continue;
     }
     if (o.attempts == 0 && under_way >= cell_.max_twins) {
       ++place;
       if (o.state != "QUEUED") {
-        store_.set_order(id, "QUEUED");
-        store_.journal("cellctl", "queued", id, "place " + std::to_string(place) + ", behind " + std::to_string(under_way) +
-                                                    " orders under way (max_twins " + std::to_string(cell_.max_twins) + ")");
+        store_.set_order(id, "QUEUED", "", -1,
+                         {"cellctl", "queued",
+                          "place " + std::to_string(place) + ", behind " + std::to_string(under_way) +
+                             " orders under way (max_twins " + std::to_string(cell_.max_twins) + ")"});
       }
       continue;
     }
@@ -102,8 +102,7 @@ void OrderDesk::tend() {
       // What to do next (the twins wrote to cellctl up's output, which the cell's operator has).
       why += ". The twins' output is in the cell's log (cellctl up); once the cause is fixed, submit the order again "
              "under another id";
-      store_.set_order(id, "FAILED", why, 1);
-      store_.journal("cellctl", "FAILED", id, why);
+      store_.set_order(id, "FAILED", why, 1, {"cellctl", "FAILED", why});
       log_("order " + id + " failed: " + why);
       continue;
     }

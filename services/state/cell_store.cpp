@@ -524,6 +524,14 @@ void CellStore::set_order(const std::string& order, const std::string& state, co
       .step();
 }
 
+void CellStore::set_order(const std::string& order, const std::string& state, const std::string& reason, int exit_code,
+                          const JournalLine& line) {
+  Transaction t(*this);
+  set_order(order, state, reason, exit_code);
+  journal(line.source, line.event, order, line.detail);
+  t.commit();
+}
+
 bool CellStore::request_cancel(const std::string& order, const std::string& who) {
   Statement(db_, "UPDATE orders SET cancelled_by = ? WHERE order_id = ? AND state NOT IN ('DONE', 'FAILED')")
       .bind(who, order)

@@ -124,7 +124,11 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
   std::vector<std::string> first_started;
   std::map<std::string, bool> under_way;
   std::size_t most = 0;
+  std::string starts_and_ends;  // what the journal said, for a failure
   for (const auto& e : state::CellStore(state).journal_since(0)) {
+    if (e.event == "twin started" || e.event == "DONE" || e.event == "FAILED") {
+      starts_and_ends += std::to_string(e.seq) + " " + e.order + " " + e.event + " (" + e.detail + ")\n";
+    }
     if (e.event == "twin started" && !under_way.count(e.order)) {
       first_started.push_back(e.order);
       under_way[e.order] = true;
@@ -132,6 +136,7 @@ TEST_CASE("order queue: past max_twins orders wait in the order they came and sa
     if ((e.event == "DONE" || e.event == "FAILED") && under_way.count(e.order)) under_way[e.order] = false;
     most = std::max<std::size_t>(most, std::count_if(under_way.begin(), under_way.end(), [](const auto& u) { return u.second; }));
   }
+  INFO(starts_and_ends);
   CHECK(first_started == ids);
   CHECK(most <= 2);
   const auto orders = state::CellStore(state).orders();

@@ -425,3 +425,40 @@ TEST_CASE("a process opens a database that has the schema while another holds th
   sqlite3_exec(writer, "ROLLBACK", nullptr, nullptr, nullptr);
   sqlite3_close(writer);
 }
+
+// The desk starts the next order once it reads that one ended; the journal must say so by
+// then, or it shows more orders under way than max_twins (the order-queue test saw 3 of 2).
+TEST_CASE("an order's change and its journal line are seen together by a reader in another connection", "[state]") {
+  const fs::path dir = fresh_dir("change-and-line");
+  state::CellStore store(dir);
+  constexpr int kOrders = 400;
+  std::thread writer([&store] {
+    for (int i = 0; i < kOrders; ++i) store.set_order("o" + std::to_string(i), "DONE", "", 0, {"twin", "DONE", ""});
+  });
+  sqlite3* reader = nullptr;
+  REQUIRE(sqlite3_open(state::CellStore::file_in(dir).c_str(), &reader) == SQLITE_OK);
+  sqlite3_busy_timeout(reader, 5000);
+  // One snapshot: orders that ended without their line (0 when every change came with it).
+  const auto unjournaled = [reader] {
+    sqlite3_exec(reader, "BEGIN", nullptr, nullptr, nullptr);
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(reader,
+                       "SELECT COUNT(*) FROM orders WHERE state = 'DONE' AND order_id NOT IN "
+                       "(SELECT order_id FROM journal WHERE event = 'DONE')",
+                       -1, &s, nullptr);
+    const int n = sqlite3_step(s) == SQLITE_ROW ? sqlite3_column_int(s, 0) : -1;
+    sqlite3_finalize(s);
+    sqlite3_exec(reader, "COMMIT", nullptr, nullptr, nullptr);
+    return n;
+  };
+  int snapshots = 0, torn = 0;
+  while (store.orders().size() < kOrders) {
+    ++snapshots;
+    if (unjournaled() != 0) ++torn;
+  }
+  writer.join();
+  sqlite3_close(reader);
+  INFO(snapshots << " snapshots");
+  CHECK(torn == 0);
+  CHECK(store.journal_since(0).size() == kOrders);
+}

@@ -110,8 +110,8 @@ class TwinProcess {
     if (store_ && state != stored_state_) {
       // The product is done: its parts on the station are counted as assembled from now on.
       if (state == "DONE") store_->assemble(options_.order);
-      store_->set_order(options_.order, state, state == "FAILED" ? message : "");
-      store_->journal("twin-" + options_.order, state, options_.order, message);
+      store_->set_order(options_.order, state, state == "FAILED" ? message : "", -1,
+                        {"twin-" + options_.order, state, message});
       stored_state_ = state;
     }
     if (!options_.quiet) std::cout << "[" << options_.order << "] " << state << ": " << message << std::endl;
@@ -232,8 +232,7 @@ class TwinProcess {
     if (store_ && !running) {
       // The cell stops the twin (it goes down): the order is paused, not over. No final
       // status: the resources keep what it booked for the twin that takes it up.
-      store_->set_order(options_.order, "INTERRUPTED", error);
-      store_->journal("twin-" + options_.order, "INTERRUPTED", options_.order, error);
+      store_->set_order(options_.order, "INTERRUPTED", error, -1, {"twin-" + options_.order, "INTERRUPTED", error});
       std::cerr << "order " << options_.order << " paused: " << error << '\n';
       return code;
     }
@@ -497,8 +496,8 @@ class TwinProcess {
     if (!finished) return watchdog.exit(end_with(1, "stopped before the order ended"));
     if (orchestrator.take_up()) {
       // Nothing released, no final status: the cell's next twin takes the order up.
-      store_->set_order(options_.order, "INTERRUPTED", orchestrator.error());
-      store_->journal("twin-" + options_.order, "to be taken up", options_.order, orchestrator.error());
+      store_->set_order(options_.order, "INTERRUPTED", orchestrator.error(), -1,
+                        {"twin-" + options_.order, "to be taken up", orchestrator.error()});
       std::cerr << "order " << options_.order << ": " << orchestrator.error() << "; the next twin takes it up\n";
       return watchdog.exit(3);
     }
