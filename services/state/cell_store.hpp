@@ -172,10 +172,10 @@ class CellStore {
   // A new order, SUBMITTED; false when an order of that id exists.
   bool submit_order(const OrderRecord& order);
   void set_order(const std::string& order, const std::string& state, const std::string& reason = "", int exit_code = -1);
-  // The order's new state and the journal's line of it in one
-  // transaction: whoever reads the state finds the line already there. Two writes let the
-  // desk start the next order between a twin's DONE and the journal's "DONE", and the journal
-  // then showed one order more under way than max_twins.
+  // The order's new state and the journal's line of it in one transaction: whoever reads the
+  // state finds the line already there. Two writes let the desk start the next order between
+  // a twin's DONE and the journal's "DONE", and the journal then showed one order more under
+  // way than max_twins.
   void set_order(const std::string& order, const std::string& state, const std::string& reason, int exit_code,
                  const JournalLine& line);
   // Asks that the order be cancelled (its twin fails it with "cancelled by WHO", through the

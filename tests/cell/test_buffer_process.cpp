@@ -92,6 +92,23 @@ std::unique_ptr<CapabilityReader> watch_capabilities(const dds::ParticipantPtr& 
       [&](const cell::Capability& c) { seen.add([&] { seen.gone.push_back(c.resource_id().to_string()); }); }, qos);
 }
 
+// Waits for what the reader must hear (as Seen::wait); when it fails, says how long it waited,
+// what the reader heard meanwhile and what the buffer printed ("ready": it had written its
+// capability).
+template <class Pred>
+void require_heard(Seen& seen, Pred pred, const std::filesystem::path& buffer_log) {
+  const auto start = std::chrono::steady_clock::now();
+  const bool heard = seen.wait(pred);
+  if (!heard) {
+    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::lock_guard<std::mutex> lock(seen.mutex);
+    UNSCOPED_INFO("not heard in " << waited << " s; heard " << seen.capabilities.size() << " capabilities and "
+                                  << seen.gone.size() << " ends; the buffer printed:\n"
+                                  << test::read_text(buffer_log));
+  }
+  REQUIRE(heard);
+}
+
 cell::Command give(const std::string& id, const std::string& part, const std::string& award,
                    const std::string& taker = "robot-1") {
   cell::Command c;
@@ -109,8 +126,10 @@ cell::Command give(const std::string& id, const std::string& part, const std::st
 
 TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stopped", "[process][buffer]") {
   test::clean_stale_dds_segments();
+  const auto log = test::scratch("buffer-gives") / "buffer-1.log";
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-1", "--domain", std::to_string(kDomain), "--stock",
-                             "SquarePeg=1", "--lease", "0.5"});
+                             "SquarePeg=1", "--lease", "0.5"},
+                            log.string());
   Seen seen;
   auto participant = dds::make_participant("test-twin", {kDomain, true, {}});
   const auto capabilities = watch_capabilities(participant, seen);
@@ -120,7 +139,7 @@ TEST_CASE("buffer process: gives parts, refuses when empty, disappears when stop
   dds::Writer<cell::Command, cell::CommandPubSubType> commands(participant, dds::command_topic("buffer-1"),
                                                                dds::TopicKind::events);
 
-  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+  require_heard(seen, [&] { return !seen.capabilities.empty(); }, log);
   CHECK(seen.last_capability().resource_id() == "buffer-1");
   CHECK(seen.last_capability().kind() == "buffer");
   CHECK(stock_of(seen.last_capability(), "SquarePeg") == 1);
@@ -174,14 +193,17 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
           "[process][buffer]") {
   constexpr int domain = domains::kBufferKilled;
   test::clean_stale_dds_segments();
+  const auto dir = test::scratch("buffer-killed");
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-2", "--domain", std::to_string(domain), "--stock",
-                             "RoundPeg=3", "--lease", "2"});
+                             "RoundPeg=3", "--lease", "2"},
+                            (dir / "buffer-2.log").string());
   // Another process of the cell, alive throughout: with Fast DDS 2.9's AUTOMATIC liveliness its
   // liveliness messages kept the dead buffer alive until the 20 s discovery lease
   // (services/dds/liveliness_keeper.hpp). A lease of 2 s: under TSan beside a CPU hog the
   // bystander may be starved half a second, and must not be taken for gone.
   test::ChildProcess bystander({BUFFER_EXE, "--id", "buffer-3", "--domain", std::to_string(domain), "--stock",
-                                "SquarePeg=1", "--lease", "2"});
+                                "SquarePeg=1", "--lease", "2"},
+                               (dir / "buffer-3.log").string());
   Seen seen;
   auto participant = dds::make_participant("test-twin", {domain, true, {}});
   const auto capabilities = watch_capabilities(participant, seen, 2.0);
@@ -189,7 +211,8 @@ TEST_CASE("buffer process killed hard: its capability goes when the liveliness l
     return std::any_of(seen.capabilities.begin(), seen.capabilities.end(),
                        [&](const cell::Capability& c) { return c.resource_id() == id; });
   };
-  REQUIRE(seen.wait([&] { return heard("buffer-2") && heard("buffer-3"); }));
+  require_heard(seen, [&] { return heard("buffer-2"); }, dir / "buffer-2.log");
+  require_heard(seen, [&] { return heard("buffer-3"); }, dir / "buffer-3.log");
 
   const auto killed = std::chrono::steady_clock::now();
   buffer.kill_hard();
@@ -212,12 +235,14 @@ TEST_CASE("buffer process stopped past its lease: gone, then its capability back
           "[process][buffer]") {
   constexpr int domain = domains::kBufferStopped;
   test::clean_stale_dds_segments();
+  const auto log = test::scratch("buffer-stopped") / "buffer-4.log";
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-4", "--domain", std::to_string(domain), "--stock",
-                             "RoundPeg=2", "--lease", "0.5"});
+                             "RoundPeg=2", "--lease", "0.5"},
+                            log.string());
   Seen seen;
   auto participant = dds::make_participant("test-twin", {domain, true, {}});
   const auto capabilities = watch_capabilities(participant, seen);
-  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+  require_heard(seen, [&] { return !seen.capabilities.empty(); }, log);
 
   ::kill(buffer.pid(), SIGSTOP);
   const bool gone = seen.wait([&] { return !seen.gone.empty(); });
@@ -258,8 +283,9 @@ TEST_CASE("a buffer that restarts answers the command its process had taken on A
       [&](const cell::CommandEvent& e) { seen.add([&] { seen.events.push_back(e); }); });
   const auto capabilities = watch_capabilities(participant, seen);
   test::ChildProcess buffer({BUFFER_EXE, "--id", "buffer-1", "--domain", std::to_string(domain), "--stock",
-                             "SquarePeg=2", "--lease", "0.5", "--state-dir", dir.string()});
-  REQUIRE(seen.wait([&] { return !seen.capabilities.empty(); }));
+                             "SquarePeg=2", "--lease", "0.5", "--state-dir", dir.string()},
+                            dir.string() + ".log");
+  require_heard(seen, [&] { return !seen.capabilities.empty(); }, dir.string() + ".log");
   // Its sender, which heard nothing, sends it again: the answer is the restart, not a give.
   dds::Writer<cell::Command, cell::CommandPubSubType> commands(participant, dds::command_topic("buffer-1"),
                                                                dds::TopicKind::events);
