@@ -125,7 +125,7 @@ OrderOrchestrator::OrderOrchestrator(std::string name, const LoadedProduct& prod
   }
   for (const Phase in : {Phase::booking, Phase::queued}) {
     transition(in, "WAITS", Phase::queued, [this](const Data& d) {
-      on_queue_news(places_[booking_.station()]);
+      if (const auto p = places_.find(booking_.station()); p != places_.end()) on_queue_news(p->second);
       if (ahead_ < 0) report_place(get<std::int64_t>(d, "ahead"));
     });
     transition(in, "STATION_OURS", Phase::hiring, [this](const Data&) { hire(); });
@@ -286,7 +286,11 @@ ModelledRun OrderOrchestrator::modelled(const Hired& h, double station_free, dou
 // for every station's hold at each decision.
 double OrderOrchestrator::hold_at(const std::string& station) const {
   const auto place = places_.find(station);
-  if (place == places_.end()) return -1;
+  if (place == places_.end()) {
+    // Its capability lapsed a moment (a starved station): its hold as it was last known.
+    const auto known = holds_.find(station);
+    return known == holds_.end() ? -1 : known->second.second;
+  }
   const Place* arm = arm_at(station);
   std::vector<double> depends_on = place->second.position;
   depends_on.insert(depends_on.end(), place->second.dock.begin(), place->second.dock.end());
@@ -364,7 +368,7 @@ void OrderOrchestrator::report_place(long ahead) {
 
 void OrderOrchestrator::hire() {
   status("WAITING", booking_.station() + " is ours; hiring its arm, a mobile robot and buffers", 0);
-  emit("CALL", booking_.arm(hold_at(booking_.station())));
+  emit("CALL", booking_.arm(std::max(0.0, hold_at(booking_.station()))));
   for (const Data& give : booking_.gives(fetched_types())) emit("CALL", give);
   if (const auto robot = booking_.robot_when_ready(fetched_types())) emit("CALL", *robot);
 }
@@ -379,7 +383,7 @@ void OrderOrchestrator::on_awarded(const Data& d) {
       return raise("WAITS", {{"ahead", std::int64_t(ahead)}});
     case Booking::For::arm:
       emit("PREPARE", {{"resource_id", resource}});  // its commands' writer, matched by the first command
-      arm_held_ = ahead == 0 || places_[resource].reserved_by == settings_.order_id;
+      arm_held_ = ahead == 0 || (places_.count(resource) && places_.at(resource).reserved_by == settings_.order_id);
       break;
     case Booking::For::robot:
       emit("PREPARE", {{"resource_id", resource}});

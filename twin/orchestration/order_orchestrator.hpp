@@ -135,8 +135,9 @@ class OrderOrchestrator : public fb::BasicChart<Phase> {
   const Timeline& timeline() const { return timeline_; }
   // How long physical assembly would hold `station` (and its arm), in s of sim time: the
   // order's script at that station timed against its arm's model (execution_model.hpp), the
-  // parts at the dock; -1 while the station's place is not known. Bids to host the order are
-  // weighed by it (ModelledFinish, order_network.hpp): each station is offered the same call.
+  // parts at the dock; while its place is not heard of (a capability that lapsed), the hold
+  // last known there, or -1. Bids to host the order are weighed by it (ModelledFinish,
+  // order_network.hpp): each station is offered the same call.
   double hold_at(const std::string& station) const;
 
  private:
