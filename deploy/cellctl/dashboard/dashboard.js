@@ -398,9 +398,15 @@
     });
   }
 
-  startScene();
   takeOrders();
   follow();
+  // The 3D view once the page has loaded: its WebGL context (software GL on a machine without
+  // a GPU: a GPU process to start) no longer holds back the tables, which say what needs
+  // attention first. On a starved machine that start took seconds, and a test's 30 s.
+  window.addEventListener("load", () => setTimeout(() => {
+    startScene();
+    drawScene();
+  }, 0));
   setInterval(() => {
     if (!page.state) return;
     document.getElementById("clock").textContent = "sim " + simNow().toFixed(1) + " s";
