@@ -400,17 +400,20 @@ class Reader : private fdds::DataReaderListener {
       for (fdds::LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
         if (infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) ended = true;
         if (!infos[i].valid_data) {
-          // An instance its writer unregistered (the end replaced its last sample): the same
-          // state written again later is news.
-          if (!as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) delivered_.erase(infos[i].instance_handle);
+          // An instance its writer unregistered or disposed, whose end replaced its last
+          // sample: the end is said with the sample last delivered.
+          if (!as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE) say_end_of_delivered(infos[i].instance_handle);
           continue;
         }
         // A new sample: its instance lived again since the end last said of it.
-        if (as_alive) ended_.erase(infos[i].instance_handle);
+        if (as_alive) {
+          ended_.erase(infos[i].instance_handle);
+          say_missed_end(infos[i]);
+        }
         // A binding that came during this drain: what waited for it goes first, in order.
         deliver_held_if_bound();
         const Source source{infos[i].sample_identity.writer_guid(), infos[i].instance_handle,
-                            !as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE};
+                            !as_alive && infos[i].instance_state != fdds::ALIVE_INSTANCE_STATE, generation(infos[i])};
         // A NEW view: the instance's first sample, or its first since it ended (its writer
         // lapsed or unregistered it), whatever was delivered before.
         if (infos[i].view_state != fdds::NEW_VIEW_STATE && repeats(samples[i], source)) continue;
@@ -490,7 +493,37 @@ class Reader : private fdds::DataReaderListener {
     Guid writer;
     fdds::InstanceHandle_t instance;
     bool gone;  // the instance's end (its writers gone, or disposed)
+    std::int64_t generation = 0;  // how many times the instance had ended when the sample came
   };
+  struct Delivered {
+    Guid writer;
+    T sample;
+    std::int64_t generation;
+  };
+
+  // An instance that ended and lived again between two drains (its writer lapsed and came
+  // back, or unregistered it and wrote it again) comes back with no end to read: its sample's
+  // generation is above the one last delivered, whose end was not said. Say it before the
+  // comeback, as a reader that looked in between would have.
+  static std::int64_t generation(const fdds::SampleInfo& info) {
+    return std::int64_t{info.disposed_generation_count} + info.no_writers_generation_count;
+  }
+  void say_missed_end(const fdds::SampleInfo& info) {
+    const auto it = delivered_.find(info.instance_handle);
+    if (it != delivered_.end() && it->second.generation < generation(info)) say_end_of_delivered(info.instance_handle);
+  }
+  void say_end_of_delivered(const fdds::InstanceHandle_t& instance) {
+    const auto it = delivered_.find(instance);
+    if (it == delivered_.end()) return;
+    const T last = it->second.sample;
+    const Source source{it->second.writer, instance, true};
+    const Verdict v = from_its_owner(last, source);
+    if (v == Verdict::take) {
+      remember(last, source);
+      if (on_gone_) on_gone_(last);
+    }
+    if (v == Verdict::hold) hold(last, source);
+  }
 
   // State topics: whether `sample` is what its writer last delivered of its instance (the
   // writer's refresh, Writer::refresh). The same state from another writer is news: a process
@@ -498,12 +531,12 @@ class Reader : private fdds::DataReaderListener {
   bool repeats(const T& sample, const Source& from) const {
     if (kind_ != TopicKind::state || from.gone) return false;
     const auto it = delivered_.find(from.instance);
-    return it != delivered_.end() && it->second.first == from.writer && it->second.second == sample;
+    return it != delivered_.end() && it->second.writer == from.writer && it->second.sample == sample;
   }
   void remember(const T& sample, const Source& from) {
     if (kind_ != TopicKind::state) return;
     if (from.gone) delivered_.erase(from.instance);
-    else delivered_.insert_or_assign(from.instance, std::make_pair(from.writer, sample));
+    else delivered_.insert_or_assign(from.instance, Delivered{from.writer, sample, from.generation});
   }
 
   // Under DDS-Security a resource may write an owned topic (or one it speaks on for itself) in
@@ -600,8 +633,8 @@ class Reader : private fdds::DataReaderListener {
   // State topics: the instances each writer spoke for with the right to, until their end.
   std::set<std::pair<eprosima::fastrtps::rtps::GUID_t, fdds::InstanceHandle_t>> trusted_;
   std::deque<Held> held_;
-  // State topics: each live instance's last delivered sample, and its writer.
-  std::map<fdds::InstanceHandle_t, std::pair<Guid, T>> delivered_;
+  // State topics: each live instance's last delivered sample, its writer and generation.
+  std::map<fdds::InstanceHandle_t, Delivered> delivered_;
   // State topics: the ended instances whose end was said, since when; and the next sweep.
   std::map<fdds::InstanceHandle_t, std::chrono::steady_clock::time_point> ended_;
   std::chrono::steady_clock::time_point next_sweep_{};
