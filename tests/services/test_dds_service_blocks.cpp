@@ -3,6 +3,7 @@
 // bounded.
 
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -264,6 +265,75 @@ TEST_CASE("state topics: an instance unregistered and written again has its end 
   changed.wait_for(lock, std::chrono::seconds(10), [&] { return said.size() >= 3; });
   changed.wait_for(lock, std::chrono::milliseconds(300), [&] { return said.size() > 3; });  // nothing more comes
   CHECK(said == std::vector<std::string>{"+buffer-1", "-buffer-1", "+buffer-1"});
+}
+
+// A drain started by a data callback runs under the reader's lock: nothing arrives meanwhile.
+// One started by a writer that left (or lapsed) does not, and an instance may end and live
+// again during it: the comeback has no end to read, only its instance's generation, one above
+// the sample last delivered. Here the reader is held in its callback for B's end (B's process
+// died) while A's writer unregisters A and writes it again. (A lease of 30 s: no refresh, so
+// no other drain, comes meanwhile.)
+TEST_CASE("state topics: an instance that ends and lives again during a drain has its end said first", "[dds]") {
+  const dds::ParticipantSettings settings{domains::kDdsEndInTheDrain, true, {}};
+  auto twin = dds::make_participant("test-twin", settings);
+  dds::QosSettings slow;
+  slow.liveliness_lease_s = 30;
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::vector<std::string> said;  // "+id" for a state, "-id" for an end, in order
+  bool holding = false, released = false;
+  const auto wait_until = [&](auto&& done) {
+    std::unique_lock<std::mutex> lock(mutex);
+    return changed.wait_for(lock, std::chrono::seconds(10), done);
+  };
+  const auto saying = [&](char sign) {
+    return [&, sign](const cell::Capability& c) {
+      std::unique_lock<std::mutex> lock(mutex);
+      said.push_back(sign + c.resource_id().to_string());
+      changed.notify_all();
+      if (said.back() != "-B") return;
+      holding = true;  // the thread that drains stays here until the test lets it go
+      changed.wait_for(lock, std::chrono::seconds(10), [&] { return released; });
+    };
+  };
+  dds::Reader<cell::Capability, cell::CapabilityPubSubType> reader(twin, "cell/capabilities", dds::TopicKind::state,
+                                                                   saying('+'), saying('-'), slow);
+  cell::Capability capability;
+  auto b_side = dds::make_participant("test-b", settings);
+  auto b = std::make_unique<CapabilityWriter>(b_side, "cell/capabilities", dds::TopicKind::state, slow);
+  REQUIRE(b->wait_for_readers(1, std::chrono::seconds(10)));
+  capability.resource_id("B");
+  REQUIRE(b->write(capability));
+  auto a_side = dds::make_participant("test-a", settings);
+  CapabilityWriter a(a_side, "cell/capabilities", dds::TopicKind::state, slow);
+  REQUIRE(a.wait_for_readers(1, std::chrono::seconds(10)));
+  capability.resource_id("A");
+  REQUIRE(a.write(capability));
+  REQUIRE(wait_until([&] { return said.size() == 2; }));
+
+  std::thread b_dies([&] {  // on a thread of its own: it may be the one held
+    b.reset();
+    b_side.reset();
+  });
+  struct LetGo {  // however the test ends: the reader let go, the thread joined
+    std::function<void()> let_go;
+    ~LetGo() { let_go(); }
+  } let_go{[&] {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      released = true;
+      changed.notify_all();
+    }
+    if (b_dies.joinable()) b_dies.join();
+  }};
+  REQUIRE(wait_until([&] { return holding; }));
+  a.unregister(capability);
+  REQUIRE(a.write(capability));
+  let_go.let_go();
+  wait_until([&] { return said.size() >= 5; });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // nothing more comes
+  std::lock_guard<std::mutex> lock(mutex);
+  CHECK(said == std::vector<std::string>{"+B", "+A", "-B", "-A", "+A"});
 }
 
 TEST_CASE("an outbox keeps what a stalled reader has no room for, and delivers it all in order once it reads again",

@@ -42,6 +42,7 @@ inline constexpr int kTwinResumes = 197;
 inline constexpr int kDownPauses = 198;
 inline constexpr int kDdsRepeatedState = 211;
 inline constexpr int kDdsMissedEnd = 47;
+inline constexpr int kDdsEndInTheDrain = 48;
 inline constexpr int kDdsStateTopics = 199;
 inline constexpr int kDdsOutbox = 200;
 inline constexpr int kStandbyTwin = 201;
@@ -80,7 +81,7 @@ inline constexpr int kAll[] = {
     kDashboard, kTwinFrozenDesk, kRealBoxOffCentre, kRunTwinFrozen, kQuotesThrifty, kBufferProcess, kBufferKilled,
     kBufferRestarts, kOrphanedProcess, kThreadedTable, kLegoTower, kCranfield, kBadOrderFailsAlone, kTwinAlone,
     kTwinBeforeTheCell, kResourceDies, kTwinDies, kTenMixedOrders, kTenQueuedOrders, kKillsMidOrder, kChaos,
-    kTwinResumes, kDownPauses, kDdsStateTopics, kDdsRepeatedState, kDdsMissedEnd, kDdsEndSaidOnce, kDdsOutbox, kStandbyTwin, kSubassemblyResumed, kNutOnBolt,
+    kTwinResumes, kDownPauses, kDdsStateTopics, kDdsRepeatedState, kDdsMissedEnd, kDdsEndInTheDrain, kDdsEndSaidOnce, kDdsOutbox, kStandbyTwin, kSubassemblyResumed, kNutOnBolt,
     kUpsideDownTable, kQuoteAccuracyA, kTwoDiscoveryServers, kCancelWhilePlanning, kTwoHostsServers, kUpPastAHostLimit,
     kHostileOpening, kHostileHugePath, kHostileUnhiredFetch, kHostileUnawardedGive, kHostileIntruderCommand,
     kHostileIntruderSim, kHostileBurst, kUpRestarts, kOneCellPerDomain, kQuoteAccuracyB, kSecureDashboard, kPki,
