@@ -501,10 +501,11 @@ class Reader : private fdds::DataReaderListener {
     std::int64_t generation;
   };
 
-  // An instance that ended and lived again between two drains (its writer lapsed and came
-  // back, or unregistered it and wrote it again) comes back with no end to read: its sample's
-  // generation is above the one last delivered, whose end was not said. Say it before the
-  // comeback, as a reader that looked in between would have.
+  // An instance that ended and lived again during a drain comes back with no end to read:
+  // its sample's generation is above the one last delivered, whose end was not said. Say it
+  // before the comeback, as a reader that looked in between would have. (A drain started by
+  // a data callback holds the reader's lock, so nothing arrives during it; one started by a
+  // lapse or a writer that left does not.)
   static std::int64_t generation(const fdds::SampleInfo& info) {
     return std::int64_t{info.disposed_generation_count} + info.no_writers_generation_count;
   }
